@@ -1,0 +1,142 @@
+"""Aircraft: a JSBSim model flown under a callsign (the paper's ``gymfg.aircraft``).
+
+``Aircraft(model, callsign)`` accepts any aircraft JSBSim ships (``available_models()``); the
+paper's three have factories: ``f15``, ``c172p`` and ``a320``. Aircraft compare and hash by
+``(model, callsign)``, so ``f15("red-one")`` written twice names the same aircraft, as the
+paper's ``reward_function_targets`` listing needs.
+"""
+
+from __future__ import annotations
+
+import difflib
+import functools
+import os
+from dataclasses import dataclass, field
+
+from gymfg_il.errors import ConfigError, UnknownAircraftError
+
+
+@dataclass(frozen=True, slots=True)
+class FlightProfile:
+    """Where an aircraft flies comfortably: the start state tasks draw around, and its limits.
+
+    Attributes:
+        cruise_kts: true airspeed at the start of an episode.
+        cruise_altitude_ft: altitude above sea level at the start of an episode.
+        cruise_throttle: throttle that roughly holds cruise_kts in level flight.
+        min_airspeed_kts: below this calibrated airspeed the aircraft counts as stalled.
+        ceiling_ft: above this altitude the aircraft has left its envelope.
+        min_agl_ft: below this height above ground the aircraft counts as crashed.
+    """
+
+    cruise_kts: float
+    cruise_altitude_ft: float
+    cruise_throttle: float
+    min_airspeed_kts: float
+    ceiling_ft: float
+    min_agl_ft: float = 50.0
+
+    def __post_init__(self) -> None:
+        problems = []
+        if not self.cruise_kts > self.min_airspeed_kts > 0:
+            problems.append(
+                f"need cruise_kts > min_airspeed_kts > 0, got {self.cruise_kts} and "
+                f"{self.min_airspeed_kts}"
+            )
+        if not 0.0 <= self.cruise_throttle <= 1.0:
+            problems.append(f"cruise_throttle={self.cruise_throttle} must lie in [0, 1]")
+        if not self.ceiling_ft > self.cruise_altitude_ft > self.min_agl_ft:
+            problems.append(
+                f"need ceiling_ft > cruise_altitude_ft > min_agl_ft, got {self.ceiling_ft}, "
+                f"{self.cruise_altitude_ft}, {self.min_agl_ft}"
+            )
+        if problems:
+            raise ConfigError("FlightProfile: " + "; ".join(problems))
+
+
+# Measured on JSBSim 1.3.3: each of these holds its cruise airspeed near level flight.
+PROFILES: dict[str, FlightProfile] = {
+    "c172p": FlightProfile(110.0, 5000.0, 0.75, 50.0, 14000.0),
+    "f15": FlightProfile(400.0, 15000.0, 0.75, 150.0, 60000.0),
+    "A320": FlightProfile(280.0, 12000.0, 0.65, 130.0, 39000.0),
+}
+GENERIC_PROFILE = FlightProfile(150.0, 6000.0, 0.7, 50.0, 40000.0)
+
+
+def jsbsim_root() -> str:
+    """The JSBSim data folder shipped with the ``jsbsim`` wheel."""
+    import jsbsim
+
+    return str(jsbsim.get_default_root_dir())
+
+
+@functools.cache
+def available_models() -> tuple[str, ...]:
+    """Every aircraft model JSBSim ships here (folders holding ``<name>/<name>.xml``)."""
+    folder = os.path.join(jsbsim_root(), "aircraft")
+    return tuple(
+        sorted(
+            name
+            for name in os.listdir(folder)
+            if os.path.isfile(os.path.join(folder, name, f"{name}.xml"))
+        )
+    )
+
+
+def resolve_model(model: str) -> str:
+    """The canonical JSBSim name of ``model`` (case-insensitive), or a clear error."""
+    models = available_models()
+    if model in models:
+        return model
+    by_lower = {m.lower(): m for m in models}
+    if isinstance(model, str) and model.lower() in by_lower:
+        return by_lower[model.lower()]
+    close = difflib.get_close_matches(str(model), models, n=5, cutoff=0.4)
+    hint = f"closest: {', '.join(close)}" if close else f"known: {', '.join(models[:12])}, ..."
+    raise UnknownAircraftError(
+        f"unknown aircraft model {model!r}: JSBSim ships no such aircraft ({hint}); "
+        "see gymfg_il.aircraft.available_models()"
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class Aircraft:
+    """A JSBSim aircraft model under a callsign, unique within its simulation.
+
+    Args:
+        model: JSBSim model name (``"c172p"``, ``"f15"``, ``"A320"``, any of
+            ``available_models()``; case-insensitive).
+        callsign: the aircraft's name in its team, e.g. ``"red-one"``.
+        profile: start state and limits; defaults to a measured profile for the paper's
+            three aircraft and a generic light-aircraft profile for the rest.
+    """
+
+    model: str
+    callsign: str
+    profile: FlightProfile = field(default=GENERIC_PROFILE, compare=False, hash=False)
+
+    def __post_init__(self) -> None:
+        canonical = resolve_model(self.model)
+        object.__setattr__(self, "model", canonical)
+        if not isinstance(self.callsign, str) or not self.callsign.strip():
+            raise ConfigError(
+                f"callsign must be a non-empty string, got {self.callsign!r}: "
+                'name the aircraft, e.g. c172p("red-one")'
+            )
+        if self.profile is GENERIC_PROFILE and canonical in PROFILES:
+            object.__setattr__(self, "profile", PROFILES[canonical])
+
+
+def f15(callsign: str) -> Aircraft:
+    """An F-15 (JSBSim ``f15``)."""
+    return Aircraft("f15", callsign)
+
+
+def c172p(callsign: str) -> Aircraft:
+    """A Cessna 172P (JSBSim ``c172p``)."""
+    return Aircraft("c172p", callsign)
+
+
+def a320(callsign: str) -> Aircraft:
+    """An Airbus A320 (JSBSim ``A320``)."""
+    return Aircraft("A320", callsign)

@@ -1,0 +1,54 @@
+"""The one interface every pilot implements: a human, a PID controller, a learned policy.
+
+Any Agent can fly any aircraft in any environment, and be recorded or evaluated the same way.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+
+@runtime_checkable
+class Agent(Protocol):
+    """Chooses ``[aileron, elevator, rudder, throttle]`` from the task's observation.
+
+    ``reset`` is called at the start of each episode with a seed derived from the
+    environment's, so a stochastic agent is reproducible too. ``opponent_states`` holds what
+    the aircraft may see of other teams (one row per aircraft), or is empty.
+    """
+
+    def reset(self, seed: int | None = None) -> None: ...
+
+    def act(
+        self, observation: np.ndarray, opponent_states: np.ndarray | None = None
+    ) -> np.ndarray: ...
+
+
+class ConstantAgent:
+    """Always the same action (handy as a baseline and for tests)."""
+
+    def __init__(self, action: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.7)):
+        self.action = np.asarray(action, dtype=np.float64)
+
+    def reset(self, seed: int | None = None) -> None:
+        pass
+
+    def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        return self.action.copy()
+
+
+class RandomAgent:
+    """Uniformly random surfaces around a fixed throttle, seeded at every reset."""
+
+    def __init__(self, scale: float = 0.3, throttle: float = 0.7) -> None:
+        self.scale, self.throttle = scale, throttle
+        self.rng = np.random.default_rng(0)
+
+    def reset(self, seed: int | None = None) -> None:
+        self.rng = np.random.default_rng(seed)
+
+    def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        surfaces = self.rng.uniform(-self.scale, self.scale, 3)
+        return np.append(surfaces, self.throttle)

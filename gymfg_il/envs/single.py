@@ -1,0 +1,139 @@
+"""The gymnasium adapter: one aircraft flying one task (registered as ``GymFG/<Family>-v0``)."""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Mapping
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from gymfg_il.aircraft import Aircraft
+from gymfg_il.envs.actions import controls
+from gymfg_il.envs.team import Team
+from gymfg_il.envs.world import EnvConfig, World
+from gymfg_il.errors import ConfigError, EnvStateError
+from gymfg_il.sim.initial import InitialConditions
+from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
+from gymfg_il.tasks.base import Task
+from gymfg_il.tasks.library import task_class
+from gymfg_il.tasks.targets import TargetTask
+
+
+class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
+    """One JSBSim aircraft flying one task, with the standard gymnasium API.
+
+    Args:
+        task: a task family name (``altitude``, ``roll``, ``pitch``, ``heading``, ``airspeed``,
+            ``level``, ``dummy``), a Task class, or a configured Task instance.
+        aircraft: JSBSim model (``c172p``, ``f15``, ``A320``, any of
+            ``gymfg_il.aircraft.available_models()``).
+        dynamic: use the family's dynamic (moving) target instead of a static one.
+        task_kwargs: arguments of the task class, e.g. ``{"target_range": (-500, 500)}``.
+        agent_hz: agent rate (Hz), an exact divisor of ``sim_hz``.
+        sim_hz: JSBSim rate (Hz).
+        episode_time_s: episode length; reaching it sets ``truncated``.
+
+    Observation: the task's observation (float32, names in ``env.observation_names``; see the
+    task's docstring for the table with units). Action: ``Box([-1, -1, -1, 0], [1, 1, 1, 1])`` =
+    ``[aileron, elevator, rudder, throttle]``; values outside are clipped, NaN/inf raise
+    ``ActionError``. Reward, start state and episode end: the task's docstring. ``terminated``
+    when the aircraft crashes, stalls or leaves its envelope (``info["reason"]``);
+    ``truncated`` at ``episode_time_s``. The time limit lives in the env, in seconds, because
+    a step count depends on ``agent_hz``.
+
+    ``reset(options=...)`` takes ``initial_conditions`` (an ``InitialConditions``) and
+    ``target`` (a fixed target for that episode, in the task's convention).
+    """
+
+    metadata = {"render_modes": []}  # noqa: RUF012
+
+    def __init__(
+        self,
+        task: str | type[Task] | Task = "altitude",
+        aircraft: str = "c172p",
+        *,
+        dynamic: bool = False,
+        task_kwargs: Mapping[str, Any] | None = None,
+        agent_hz: int = 10,
+        sim_hz: int = 120,
+        episode_time_s: float = 90.0,
+        render_mode: str | None = None,
+    ) -> None:
+        if render_mode is not None:
+            raise ConfigError(f"render_mode={render_mode!r} is not supported; use None")
+        kwargs = dict(task_kwargs or {})
+        if isinstance(task, str):
+            spec: Any = functools.partial(task_class(task, dynamic), **kwargs)
+        elif isinstance(task, type) and issubclass(task, Task):
+            spec = functools.partial(task, **kwargs)
+        elif isinstance(task, Task):
+            if kwargs:
+                raise ConfigError("task_kwargs apply to a task name or class, not an instance")
+            spec = task
+        else:
+            raise ConfigError(f"task={task!r} must be a family name, a Task class or instance")
+        self.aircraft = Aircraft(aircraft, "ego")
+        team = Team("ego", [(self.aircraft, spec)], episode_time_s=episode_time_s)
+        self.world = World([team], EnvConfig(sim_hz=sim_hz, agent_hz=agent_hz))
+        self._slot = self.world.slots[0]
+        self.task = self._slot.task
+        low, high = self.task.observation_bounds()
+        self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
+        self.action_space = gym.spaces.Box(ACTION_LOW, ACTION_HIGH, dtype=np.float32)
+        self.observation_names = self.task.observation_names
+        self.render_mode = render_mode
+        self._done = True
+
+    @property
+    def dt(self) -> float:
+        return self.world.dt
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        options = dict(options or {})
+        ic = options.pop("initial_conditions", None)
+        target = options.pop("target", None)
+        if options:
+            raise ConfigError(
+                f"unknown reset options {sorted(options)}; known: initial_conditions, target"
+            )
+        if ic is not None and not isinstance(ic, InitialConditions):
+            raise ConfigError(f"initial_conditions must be InitialConditions, got {ic!r}")
+        overrides = {"ego": ic} if ic is not None else None
+        task = self.task
+        if target is not None:
+            if not isinstance(task, TargetTask):
+                raise ConfigError(f"{type(task).__name__} has no target to set")
+            saved, task.fixed_target = task.fixed_target, float(target)
+            try:
+                self.world.reset(self.np_random, overrides)
+            finally:
+                task.fixed_target = saved
+        else:
+            self.world.reset(self.np_random, overrides)
+        self._done = False
+        slot = self._slot
+        info = {"target": task.target_value(0), "start": slot.state.copy()}
+        return task.observe(slot.state, 0), info
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        if self._done:
+            raise EnvStateError("call reset() before step(), and again after an episode ends")
+        ctrl = controls(action)
+        world = self.world
+        world.advance((ctrl,))
+        slot = self._slot
+        terminated = slot.terminated
+        truncated = world.steps >= world.max_steps and not terminated
+        self._done = terminated or truncated
+        info = {"reason": slot.reason} if terminated else {}
+        return slot.task.observe(slot.state, world.steps), slot.reward, terminated, truncated, info
+
+    def close(self) -> None:
+        if self.world.slots:
+            self.world.close()
+            self.world.pool.close()

@@ -1,0 +1,271 @@
+"""The central state of one simulation: every aircraft of every team, stepped in lockstep.
+
+``World`` is what the offline env, the gymnasium and PettingZoo adapters and (later) the online
+server share. It owns one ``Simulation`` per aircraft, the tasks, the reward contexts and the
+clock; it knows nothing about who chooses the actions.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from gymfg_il.aircraft import Aircraft
+from gymfg_il.envs.actions import Controls
+from gymfg_il.envs.team import Team, build_task, check_unique
+from gymfg_il.errors import ConfigError
+from gymfg_il.sim.initial import InitialConditions
+from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, NAMES, StateView, indices
+from gymfg_il.sim.simulation import Simulation
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, episode_steps, substeps
+from gymfg_il.tasks.base import Task
+from gymfg_il.tasks.rewards import RewardContext
+
+# A scenario sets joint initial conditions: (rng, [(team name, aircraft), ...]) -> {callsign: ic}.
+Scenario = Callable[
+    [np.random.Generator, Sequence[tuple[str, Aircraft]]], Mapping[str, InitialConditions]
+]
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """Settings shared by every environment.
+
+    Args:
+        sim_hz: JSBSim rate (Hz).
+        agent_hz: agent rate (Hz); must divide ``sim_hz`` exactly; it is a dataset's fps.
+        opponent_view: the state variables an aircraft sees of other teams' aircraft
+            (position and orientation by default, as in the paper).
+        scenario: joint initial conditions overriding the tasks' own (see ``envs.scenarios``).
+    """
+
+    sim_hz: int = DEFAULT_SIM_HZ
+    agent_hz: int = DEFAULT_AGENT_HZ
+    opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW
+    scenario: Scenario | None = None
+
+    def __post_init__(self) -> None:
+        substeps(self.sim_hz, self.agent_hz)
+        view = tuple(self.opponent_view)
+        object.__setattr__(self, "opponent_view", view)
+        indices(view)
+        if len(set(view)) != len(view):
+            raise ConfigError(f"opponent_view lists a variable twice: {view}")
+        if self.scenario is not None and not callable(self.scenario):
+            raise ConfigError(f"scenario must be callable (rng, aircraft) -> ics, got {self.scenario!r}")
+
+    @property
+    def dt(self) -> float:
+        return 1.0 / self.agent_hz
+
+
+class SimPool:
+    """JSBSim instances kept across reconfigurations, so each is built once per model."""
+
+    def __init__(self, sim_hz: int, agent_hz: int) -> None:
+        self.sim_hz, self.agent_hz = sim_hz, agent_hz
+        self._free: dict[str, list[Simulation]] = {}
+
+    def take(self, model: str) -> Simulation:
+        free = self._free.get(model)
+        return free.pop() if free else Simulation(model, self.sim_hz, self.agent_hz)
+
+    def give_back(self, sims: Sequence[Simulation]) -> None:
+        for sim in sims:
+            self._free.setdefault(sim.model, []).append(sim)
+
+    def close(self) -> None:
+        for sims in self._free.values():
+            for sim in sims:
+                sim.close()
+        self._free.clear()
+
+
+class Slot:
+    """One aircraft's place in the world: its sim, task, last states, actions and reward."""
+
+    __slots__ = (
+        "action",
+        "aircraft",
+        "ctx",
+        "history",
+        "index",
+        "prev_action",
+        "prev_state",
+        "reason",
+        "reward",
+        "sim",
+        "state",
+        "target_links",
+        "task",
+        "team",
+        "terminated",
+    )
+
+    def __init__(self, index: int, team: str, aircraft: Aircraft, task: Task, sim: Simulation):
+        self.index = index
+        self.team = team
+        self.aircraft = aircraft
+        self.task = task
+        self.sim = sim
+        self.state = np.zeros(len(NAMES))
+        self.prev_state = self.state
+        self.action = np.zeros(4)
+        self.prev_action = self.action
+        self.reward = 0.0
+        self.terminated = False
+        self.reason: str | None = None
+        self.history: deque[tuple[np.ndarray, np.ndarray]] = deque(
+            maxlen=max(task.history_window, 1)
+        )
+        self.ctx = RewardContext(StateView(self.state), StateView(self.state), self.action,
+                                 self.action, history=self.history)
+        # (view to refresh, source slot, restricted to the opponent view?)
+        self.target_links: list[tuple[StateView, Slot, bool]] = []
+
+    @property
+    def callsign(self) -> str:
+        return self.aircraft.callsign
+
+
+class World:
+    """All aircraft of all teams, stepped together at ``config.agent_hz``."""
+
+    def __init__(self, teams: Sequence[Team], config: EnvConfig, pool: SimPool | None = None):
+        if not teams:
+            raise ConfigError("a simulation needs at least one Team")
+        check_unique(teams)
+        self.teams = list(teams)
+        self.config = config
+        self.pool = pool or SimPool(config.sim_hz, config.agent_hz)
+        self.view_idx = indices(config.opponent_view)
+        self.max_steps = min(episode_steps(t.episode_time_s, config.agent_hz) for t in teams)
+        self.dt = config.dt
+        self.slots: list[Slot] = []
+        for team in teams:
+            for aircraft, spec in team.roster:
+                task = build_task(spec, f"team {team.name!r}, aircraft {aircraft.callsign!r}")
+                task.bind(aircraft, self.dt, self.max_steps)
+                sim = self.pool.take(aircraft.model)
+                self.slots.append(Slot(len(self.slots), team.name, aircraft, task, sim))
+        self.by_callsign = {s.callsign: s for s in self.slots}
+        self.team_slots = {t.name: [s for s in self.slots if s.team == t.name] for t in teams}
+        self._link_reward_targets()
+        self.steps = 0
+        self.started = False
+
+    def _link_reward_targets(self) -> None:
+        view_names = self.config.opponent_view
+        for team in self.teams:
+            for owner, targets in team.reward_function_targets.items():
+                slot = self.by_callsign[owner.callsign]
+                for target in targets:
+                    source = self.by_callsign.get(target.callsign)
+                    if source is None or source.aircraft.model != target.model:
+                        raise ConfigError(
+                            f"team {team.name!r}: {owner.callsign!r} takes reward target "
+                            f"{target!r}, which is not in this simulation"
+                        )
+                    restricted = source.team != slot.team
+                    view = StateView(source.state[self.view_idx], view_names) if restricted \
+                        else StateView(source.state)
+                    slot.ctx.targets[target.callsign] = view
+                    slot.target_links.append((view, source, restricted))
+
+    # -- episode ------------------------------------------------------------------------
+    def reset(
+        self,
+        rng: np.random.Generator,
+        overrides: Mapping[str, InitialConditions] | None = None,
+    ) -> None:
+        """Start an episode: joint (scenario), overridden or per-task initial conditions."""
+        scenario = self.config.scenario
+        ics: dict[str, InitialConditions] = {}
+        if scenario is not None:
+            ics.update(scenario(rng, [(s.team, s.aircraft) for s in self.slots]))
+        ics.update(overrides or {})
+        unknown = set(ics) - set(self.by_callsign)
+        if unknown:
+            raise ConfigError(f"initial conditions given for unknown callsigns {sorted(unknown)}")
+        for slot in self.slots:
+            ic = ics.get(slot.callsign) or slot.task.initial_conditions(rng)
+            throttle = slot.aircraft.profile.cruise_throttle
+            slot.state = slot.prev_state = slot.sim.reset(ic, throttle)
+            slot.task.reset(slot.state, rng)
+            slot.action = slot.prev_action = np.array([0.0, 0.0, 0.0, throttle])
+            slot.reward = 0.0
+            slot.terminated = False
+            slot.reason = None
+            slot.history.clear()
+        self.steps = 0
+        self.started = True
+
+    def advance(self, actions: Sequence[Controls | None]) -> None:
+        """Apply one action per slot (None for terminated aircraft), step, score, check ends."""
+        slots = self.slots
+        for slot, act in zip(slots, actions, strict=True):
+            if slot.terminated or act is None:
+                continue
+            slot.sim.apply(*act)
+            if slot.task.history_window:
+                slot.history.append((slot.prev_state, slot.prev_action))
+            slot.prev_state = slot.state
+            slot.state = slot.sim.read()
+            slot.prev_action = slot.action
+            slot.action = np.array(act)
+        self.steps += 1
+        for slot in slots:
+            if slot.terminated:
+                slot.reward = 0.0
+                continue
+            self._score(slot)
+
+    def _score(self, slot: Slot) -> None:
+        ctx = slot.ctx
+        ctx.state.values = slot.state
+        ctx.prev_state.values = slot.prev_state
+        ctx.action = slot.action
+        ctx.prev_action = slot.prev_action
+        ctx.step = self.steps
+        ctx.dt = self.dt
+        task = slot.task
+        ctx.target = task.target_value(self.steps)
+        for view, source, restricted in slot.target_links:
+            view.values = source.state[self.view_idx] if restricted else source.state
+        reward = task.reward(ctx)
+        if not math.isfinite(reward):
+            raise ConfigError(
+                f"the reward of {slot.callsign!r} ({type(task).__name__}) returned {reward!r}; "
+                "rewards must be finite"
+            )
+        slot.reward = reward
+        reason = task.termination(slot.state)
+        if reason is not None:
+            slot.terminated = True
+            slot.reason = reason
+
+    # -- views --------------------------------------------------------------------------
+    @property
+    def truncated(self) -> bool:
+        return self.steps >= self.max_steps
+
+    def observation(self, slot: Slot) -> np.ndarray:
+        return slot.task.observe(slot.state, self.steps)
+
+    def opponents_of(self, team: str) -> list[Slot]:
+        return [s for s in self.slots if s.team != team]
+
+    def opponent_states(self, team: str) -> np.ndarray:
+        """What ``team`` sees of every other team's aircraft: (n, len(opponent_view)) float64."""
+        rows = [s.state[self.view_idx] for s in self.slots if s.team != team]
+        if not rows:
+            return np.zeros((0, len(self.view_idx)))
+        return np.stack(rows)
+
+    def close(self) -> None:
+        self.pool.give_back([s.sim for s in self.slots])
+        self.slots = []

@@ -1,0 +1,160 @@
+"""One aircraft's JSBSim instance: built once, reset many times, stepped with cached nodes.
+
+The hot path (``apply`` + ``read``) touches JSBSim only through property nodes cached at build
+time and plain Python floats, so an agent step costs little beyond the physics itself
+(``benchmarks/run.py`` measures it against a bare ``FGFDMExec.run()`` loop).
+"""
+
+from __future__ import annotations
+
+import atexit
+import logging
+import os
+import shutil
+import tempfile
+from collections.abc import Callable
+
+import numpy as np
+
+from gymfg_il.aircraft import jsbsim_root, resolve_model
+from gymfg_il.sim.initial import InitialConditions
+from gymfg_il.sim.properties import CATALOGUE, StateVar
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
+
+log = logging.getLogger(__name__)
+
+_ic_dir: str | None = None
+
+
+def _quiet_jsbsim() -> None:
+    """Silence JSBSim's banner and load chatter for every instance made afterwards."""
+    import jsbsim
+
+    jsbsim.FGJSBBase().debug_lvl = 0
+
+
+def _ic_folder() -> str:
+    global _ic_dir
+    if _ic_dir is None:
+        _ic_dir = tempfile.mkdtemp(prefix="gymfg-ic-")
+        atexit.register(shutil.rmtree, _ic_dir, True)
+    return _ic_dir
+
+
+class Simulation:
+    """A JSBSim ``FGFDMExec`` for one aircraft model at ``sim_hz``, stepped at ``agent_hz``.
+
+    Args:
+        model: JSBSim aircraft model (case-insensitive).
+        sim_hz: JSBSim integration rate; 120 Hz by default.
+        agent_hz: agent rate; must divide ``sim_hz`` exactly.
+        catalogue: the state variables ``read()`` returns, in order.
+    """
+
+    def __init__(
+        self,
+        model: str,
+        sim_hz: int = DEFAULT_SIM_HZ,
+        agent_hz: int = DEFAULT_AGENT_HZ,
+        catalogue: tuple[StateVar, ...] = CATALOGUE,
+    ) -> None:
+        import jsbsim
+
+        self.model = resolve_model(model)
+        self.sim_hz = sim_hz
+        self.agent_hz = agent_hz
+        self.substeps = substeps(sim_hz, agent_hz)
+        _quiet_jsbsim()
+        fdm = jsbsim.FGFDMExec(jsbsim_root())
+        fdm.set_debug_level(0)
+        if not fdm.load_model(self.model):
+            raise RuntimeError(f"JSBSim could not load aircraft {self.model!r}")
+        fdm.set_dt(1.0 / sim_hz)
+        self.fdm = fdm
+        pm = fdm.get_property_manager()
+        self.engines = max(1, fdm.get_propulsion().get_num_engines())
+
+        def node(prop: str) -> object:
+            n = pm.get_node(prop, True) if not pm.hasNode(prop) else pm.get_node(prop)
+            if n is None:
+                raise RuntimeError(f"JSBSim model {self.model!r} has no property {prop!r}")
+            return n
+
+        self._getters: list[Callable[[], float]] = [
+            node(v.prop).get_double_value for v in catalogue  # type: ignore[attr-defined]
+        ]
+        setters = [
+            node(p).set_double_value  # type: ignore[attr-defined]
+            for p in ("fcs/aileron-cmd-norm", "fcs/elevator-cmd-norm", "fcs/rudder-cmd-norm")
+        ]
+        self._set_aileron, self._set_elevator, self._set_rudder = setters
+        self._set_throttles: list[Callable[[float], None]] = [
+            node(f"fcs/throttle-cmd-norm[{i}]").set_double_value  # type: ignore[attr-defined]
+            for i in range(self.engines)
+        ]
+        self._mixtures = [f"fcs/mixture-cmd-norm[{i}]" for i in range(self.engines)]
+        self._has_gear = pm.hasNode("gear/gear-cmd-norm")
+        self._run = fdm.run
+        self._substep_range = range(self.substeps)
+        fd, self._ic_path = tempfile.mkstemp(suffix=".xml", dir=_ic_folder())
+        os.close(fd)
+        self.resets = 0
+        if self._has_gear:
+            self._retract_gear()
+
+    @property
+    def dt(self) -> float:
+        """Seconds of simulated time per agent step."""
+        return self.substeps / self.sim_hz
+
+    def reset(self, ic: InitialConditions, throttle: float = 0.0) -> np.ndarray:
+        """Put the aircraft in ``ic`` with engines running; return the first state vector."""
+        xml = ic.to_xml().replace("</initialize>", " <running>-1</running>\n</initialize>")
+        with open(self._ic_path, "w", encoding="ascii") as f:
+            f.write(xml)
+        fdm = self.fdm
+        fdm.get_ic().load(self._ic_path, False)
+        for prop in self._mixtures:
+            fdm[prop] = 1.0
+        self.apply(0.0, 0.0, 0.0, throttle, run=False)
+        if self._has_gear:
+            fdm["gear/gear-cmd-norm"] = 0.0
+        fdm.reset_to_initial_conditions(0)
+        self.resets += 1
+        return self.read()
+
+    def _retract_gear(self) -> None:
+        """Fly once with the gear commanded up until it is stowed.
+
+        JSBSim keeps the gear actuator's position across resets, so a fresh instance would
+        start its first episode with the gear down and later ones with it up. Stowing it once
+        at build time makes every episode start alike.
+        """
+        self.reset(InitialConditions(altitude_ft=30000.0, airspeed_kts=250.0))
+        for _ in range(60 * self.sim_hz):
+            if self.fdm["gear/gear-pos-norm"] <= 0.0:
+                break
+            self._run()
+        self.resets = 0
+
+    def apply(
+        self, aileron: float, elevator: float, rudder: float, throttle: float, run: bool = True
+    ) -> None:
+        """Set the four controls, then advance JSBSim one agent step (``substeps`` frames)."""
+        self._set_aileron(aileron)
+        self._set_elevator(elevator)
+        self._set_rudder(rudder)
+        for set_throttle in self._set_throttles:
+            set_throttle(throttle)
+        if run:
+            step = self._run
+            for _ in self._substep_range:
+                step()
+
+    def read(self) -> np.ndarray:
+        """The catalogue's values now, as a new float64 vector."""
+        return np.array([get() for get in self._getters])
+
+    def close(self) -> None:
+        if os.path.exists(self._ic_path):
+            os.remove(self._ic_path)

@@ -1,0 +1,50 @@
+"""Tasks: each aircraft's observation, reward, termination and start state.
+
+Submodules: ``base`` (Task), ``targets`` (static/dynamic target machinery), ``library`` (the
+named tasks), ``rewards`` (RewardContext and shaping), ``geometry``, ``orientation`` and
+``state`` (the state-variable catalogue and StateView).
+"""
+
+from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.library import (
+    TASK_FAMILIES,
+    DummyTask,
+    LevelFlightTask,
+    ReachDynamicTargetAirspeedTask,
+    ReachDynamicTargetAltitudeTask,
+    ReachDynamicTargetHeadingTask,
+    ReachDynamicTargetPitchTask,
+    ReachDynamicTargetRollTask,
+    ReachStaticTargetAirspeedTask,
+    ReachStaticTargetAltitudeTask,
+    ReachStaticTargetHeadingTask,
+    ReachStaticTargetPitchTask,
+    ReachStaticTargetRollTask,
+    task_class,
+)
+from gymfg_il.tasks.rewards import RewardContext, RewardFn
+from gymfg_il.tasks.targets import FAMILIES, TargetFamily, TargetTask
+
+__all__ = [
+    "FAMILIES",
+    "FLIGHT_VARS",
+    "TASK_FAMILIES",
+    "DummyTask",
+    "LevelFlightTask",
+    "ReachDynamicTargetAirspeedTask",
+    "ReachDynamicTargetAltitudeTask",
+    "ReachDynamicTargetHeadingTask",
+    "ReachDynamicTargetPitchTask",
+    "ReachDynamicTargetRollTask",
+    "ReachStaticTargetAirspeedTask",
+    "ReachStaticTargetAltitudeTask",
+    "ReachStaticTargetHeadingTask",
+    "ReachStaticTargetPitchTask",
+    "ReachStaticTargetRollTask",
+    "RewardContext",
+    "RewardFn",
+    "Task",
+    "TargetFamily",
+    "TargetTask",
+    "task_class",
+]

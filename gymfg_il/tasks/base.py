@@ -1,0 +1,159 @@
+"""The Task: what one aircraft observes, how it is rewarded, when it stops, and how it starts.
+
+A task instance belongs to one aircraft in one environment (the environment builds it from the
+team roster). Subclasses set ``observation_vars`` and override ``reward`` (or any hook); a new
+reward without a subclass is one lambda: ``DummyTask(reward=lambda ctx: ...)``.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from gymfg_il.aircraft import Aircraft
+from gymfg_il.errors import ConfigError
+from gymfg_il.sim.initial import InitialConditions
+from gymfg_il.aircraft import FlightProfile
+from gymfg_il.sim.properties import BY_NAME, INDEX, indices
+from gymfg_il.tasks.rewards import RewardContext, RewardFn
+
+# The flight state every built-in task observes, before its own extras.
+FLIGHT_VARS: tuple[str, ...] = (
+    "altitude_ft",
+    "vertical_speed_fps",
+    "roll_deg",
+    "pitch_deg",
+    "airspeed_kts",
+    "p_rad_s",
+    "q_rad_s",
+    "r_rad_s",
+    "alpha_deg",
+    "beta_deg",
+)
+
+_AGL = INDEX["altitude_agl_ft"]
+_ALT = INDEX["altitude_ft"]
+_VC = INDEX["airspeed_kts"]
+
+
+class Task:
+    """Base task: observe ``observation_vars``, reward 0, stop on leaving the envelope.
+
+    Args:
+        reward: a ``Callable[[RewardContext], float]`` that replaces the task's own reward.
+        history_window: how many (state, action) pairs before the previous step the reward
+            context keeps in ``ctx.history`` (0: only previous and current, the paper's default).
+        start: a fixed start state; by default each episode draws one around the aircraft's
+            cruise profile (altitude +/- 500 ft, any heading, airspeed +/- 5 %).
+    """
+
+    name: ClassVar[str] = "task"
+    observation_vars: ClassVar[tuple[str, ...]] = FLIGHT_VARS
+    extra_names: ClassVar[tuple[str, ...]] = ()
+
+    def __init__(
+        self,
+        *,
+        reward: RewardFn | None = None,
+        history_window: int = 0,
+        start: InitialConditions | None = None,
+    ) -> None:
+        if reward is not None and not callable(reward):
+            raise ConfigError(f"reward must be callable (a RewardFn), got {reward!r}")
+        if isinstance(history_window, bool) or not isinstance(history_window, int) or (
+            history_window < 0
+        ):
+            raise ConfigError(f"history_window must be an integer >= 0, got {history_window!r}")
+        self._custom_reward = reward
+        self.history_window = history_window
+        self.start = start
+        self._obs_idx = indices(self.observation_vars)
+        self._n_vars = len(self.observation_vars)
+        self.aircraft: Aircraft | None = None
+        self.dt = 0.1
+        self.max_steps = 900
+        self._min_agl = 50.0
+        self._min_vc = 0.0
+        self._ceiling = 1e9
+
+    # -- wiring -------------------------------------------------------------------------
+    def bind(self, aircraft: Aircraft, dt: float, max_steps: int) -> None:
+        """Attach the task to its aircraft; the environment calls this once."""
+        self.aircraft = aircraft
+        self.dt = dt
+        self.max_steps = max_steps
+        profile = aircraft.profile
+        self._min_agl = profile.min_agl_ft
+        self._min_vc = profile.min_airspeed_kts
+        self._ceiling = profile.ceiling_ft
+
+    @property
+    def observation_names(self) -> tuple[str, ...]:
+        """Names of the observation vector's entries, in order."""
+        return self.observation_vars + self.extra_names
+
+    def observation_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(low, high) of the observation, float32, from the catalogue's bounds."""
+        low = [BY_NAME[n].low for n in self.observation_vars] + list(self._extra_bounds()[0])
+        high = [BY_NAME[n].high for n in self.observation_vars] + list(self._extra_bounds()[1])
+        return np.array(low, np.float32), np.array(high, np.float32)
+
+    def _extra_bounds(self) -> tuple[list[float], list[float]]:
+        return [], []
+
+    # -- episode ------------------------------------------------------------------------
+    def initial_conditions(self, rng: np.random.Generator) -> InitialConditions:
+        """This episode's start state (drawn from ``rng`` unless ``start`` fixes it)."""
+        if self.start is not None:
+            return self.start
+        profile = self._profile()
+        return InitialConditions(
+            altitude_ft=profile.cruise_altitude_ft + float(rng.uniform(-500.0, 500.0)),
+            heading_deg=float(rng.uniform(0.0, 360.0)),
+            airspeed_kts=profile.cruise_kts * float(rng.uniform(0.95, 1.05)),
+        )
+
+    def reset(self, state: np.ndarray, rng: np.random.Generator) -> None:
+        """Start an episode from ``state`` (draw targets here); the base task has none."""
+
+    def observe(self, state: np.ndarray, step: int) -> np.ndarray:
+        """The observation (float32) of catalogue-ordered ``state`` at agent step ``step``."""
+        return state[self._obs_idx].astype(np.float32)
+
+    def reward(self, ctx: RewardContext) -> float:
+        """The step's reward: the custom reward if one was given, else ``task_reward``."""
+        if self._custom_reward is not None:
+            return float(self._custom_reward(ctx))
+        return self.task_reward(ctx)
+
+    def task_reward(self, ctx: RewardContext) -> float:
+        """The task's own reward; 0 for the base task."""
+        return 0.0
+
+    def target_value(self, step: int) -> float | None:
+        """The target at ``step`` (None for tasks without one)."""
+        return None
+
+    def termination(self, state: np.ndarray) -> str | None:
+        """Why the aircraft must stop now (crashed, stalled, ...), or None to go on."""
+        agl = state[_AGL]
+        if not agl == agl or not state[_VC] == state[_VC]:
+            return "diverged"
+        if agl < self._min_agl:
+            return "crashed"
+        if state[_VC] < self._min_vc:
+            return "stalled"
+        if state[_ALT] > self._ceiling:
+            return "above_ceiling"
+        return None
+
+    def describe(self) -> dict[str, object]:
+        """What the task is, for logs and dataset metadata."""
+        return {"task": self.name, "observation": list(self.observation_names)}
+
+    def _profile(self) -> FlightProfile:
+        if self.aircraft is None:
+            raise ConfigError(f"{type(self).__name__} is not bound to an aircraft yet")
+        return self.aircraft.profile
+

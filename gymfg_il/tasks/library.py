@@ -1,0 +1,225 @@
+"""The task library: the dummy task, static and dynamic target tasks, and level flight.
+
+Every task observes the flight state first (``FLIGHT_VARS``):
+
+| name | unit | meaning |
+| --- | --- | --- |
+| altitude_ft | ft | altitude above sea level |
+| vertical_speed_fps | ft/s | climb rate |
+| roll_deg, pitch_deg | deg | attitude |
+| airspeed_kts | kt | calibrated airspeed |
+| p_rad_s, q_rad_s, r_rad_s | rad/s | body rates |
+| alpha_deg, beta_deg | deg | angle of attack, sideslip |
+
+Common to all: the start state is drawn around the aircraft's cruise profile (altitude +/- 500
+ft, any heading, airspeed +/- 5 %, wings level) unless ``start=`` fixes it; an aircraft that
+crashes (below ``min_agl_ft``), stalls (below ``min_airspeed_kts``), climbs above its ceiling or
+diverges is ``terminated``; the episode time limit (Team.episode_time_s, 90 s by default) makes
+it ``truncated``. The action is ``[aileron, elevator, rudder, throttle]``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gymfg_il.sim.properties import INDEX
+from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.rewards import RewardContext, action_change
+from gymfg_il.tasks.targets import (
+    AIRSPEED,
+    ALTITUDE,
+    FAMILIES,
+    HEADING,
+    PITCH,
+    ROLL,
+    SMOOTHNESS_WEIGHT,
+    TargetTask,
+)
+
+
+class DummyTask(Task):
+    """The paper's placeholder: observe the flight state, reward 0 (or a given lambda).
+
+    Observation: ``FLIGHT_VARS`` (10 values). Reward: 0, or ``reward(ctx)`` when given.
+    Start and end: as every task (module docstring).
+    """
+
+    name = "dummy"
+
+
+_TARGET_DOC = """
+
+    Observation: ``FLIGHT_VARS`` {extra}then ``{var}_target`` ({unit}) and ``{var}_error``
+    (target - value{wrap}).
+    Target: {target}.
+    Reward per step: ``exp(-|error| / {scale:g}) - 0.05 * mean |change of aileron, elevator,
+    rudder|`` (at most 1).
+    Start and end: as every task (module docstring).
+    """
+
+
+def _doc(summary: str, fam: object, dynamic: bool, unit: str) -> str:
+    f = fam  # a TargetFamily
+    low, high = f.target_range  # type: ignore[attr-defined]
+    where = "an offset from the start value" if f.relative else "an absolute value"  # type: ignore[attr-defined]
+    target = f"drawn per episode from [{low:g}, {high:g}] {unit}, {where}"
+    if dynamic:
+        target += (
+            f"; then every hold_s (20 s) a new waypoint is drawn and the target moves towards "
+            f"it at {f.rate:g} {unit}/s"  # type: ignore[attr-defined]
+        )
+    extra = "".join(f"and ``{v}`` " for v in f.extra_vars)  # type: ignore[attr-defined]
+    return summary + _TARGET_DOC.format(
+        extra=extra,
+        var=f.variable,  # type: ignore[attr-defined]
+        unit=unit,
+        wrap=", wrapped to [-180, 180)" if f.angular else "",  # type: ignore[attr-defined]
+        target=target,
+        scale=f.reward_scale,  # type: ignore[attr-defined]
+    )
+
+
+class ReachStaticTargetAltitudeTask(TargetTask):
+    family = ALTITUDE
+    name = "altitude"
+    __doc__ = _doc("Climb or descend to a fixed altitude and hold it.", ALTITUDE, False, "ft")
+
+
+class ReachDynamicTargetAltitudeTask(TargetTask):
+    family = ALTITUDE
+    dynamic = True
+    name = "altitude-dynamic"
+    __doc__ = _doc("Track an altitude target that moves during the episode.", ALTITUDE, True, "ft")
+
+
+class ReachStaticTargetRollTask(TargetTask):
+    family = ROLL
+    name = "roll"
+    __doc__ = _doc("Bank to a fixed roll angle and hold it.", ROLL, False, "deg")
+
+
+class ReachDynamicTargetRollTask(TargetTask):
+    family = ROLL
+    dynamic = True
+    name = "roll-dynamic"
+    __doc__ = _doc("Track a roll target that moves during the episode.", ROLL, True, "deg")
+
+
+class ReachStaticTargetPitchTask(TargetTask):
+    family = PITCH
+    name = "pitch"
+    __doc__ = _doc("Pitch to a fixed attitude and hold it.", PITCH, False, "deg")
+
+
+class ReachDynamicTargetPitchTask(TargetTask):
+    family = PITCH
+    dynamic = True
+    name = "pitch-dynamic"
+    __doc__ = _doc("Track a pitch target that moves during the episode.", PITCH, True, "deg")
+
+
+class ReachStaticTargetHeadingTask(TargetTask):
+    family = HEADING
+    name = "heading"
+    __doc__ = _doc("Turn to a fixed heading and hold it.", HEADING, False, "deg")
+
+
+class ReachDynamicTargetHeadingTask(TargetTask):
+    family = HEADING
+    dynamic = True
+    name = "heading-dynamic"
+    __doc__ = _doc("Track a heading target that moves during the episode.", HEADING, True, "deg")
+
+
+class ReachStaticTargetAirspeedTask(TargetTask):
+    family = AIRSPEED
+    name = "airspeed"
+    __doc__ = _doc("Reach a fixed calibrated airspeed and hold it.", AIRSPEED, False, "kt")
+
+
+class ReachDynamicTargetAirspeedTask(TargetTask):
+    family = AIRSPEED
+    dynamic = True
+    name = "airspeed-dynamic"
+    __doc__ = _doc("Track an airspeed target that moves during the episode.", AIRSPEED, True, "kt")
+
+
+_ALT = INDEX["altitude_ft"]
+_HDG = INDEX["heading_deg"]
+_ROLL = INDEX["roll_deg"]
+
+
+class LevelFlightTask(Task):
+    """Hold the start altitude and heading with wings level.
+
+    Observation: ``FLIGHT_VARS`` and ``heading_deg``, then ``altitude_ft_error`` (start
+    altitude - altitude, ft) and ``heading_deg_error`` (start heading - heading, deg, wrapped).
+    Reward per step: ``0.5 exp(-|altitude error| / 100) + 0.3 exp(-|heading error| / 5) +
+    0.2 exp(-|roll| / 5) - 0.05 * mean |change of aileron, elevator, rudder|``.
+    Start and end: as every task (module docstring).
+    """
+
+    name = "level"
+    observation_vars = (*FLIGHT_VARS, "heading_deg")
+    extra_names = ("altitude_ft_error", "heading_deg_error")
+    altitude_tolerance = 50.0
+    heading_tolerance = 3.0
+
+    def _extra_bounds(self) -> tuple[list[float], list[float]]:
+        return [-1e5, -180.0], [1e5, 180.0]
+
+    def reset(self, state: np.ndarray, rng: np.random.Generator) -> None:
+        self.start_altitude = float(state[_ALT])
+        self.start_heading = float(state[_HDG])
+
+    def errors(self, state: np.ndarray) -> tuple[float, float]:
+        """(altitude error ft, heading error deg) of ``state``."""
+        heading_err = (self.start_heading - state[_HDG] + 180.0) % 360.0 - 180.0
+        return self.start_altitude - float(state[_ALT]), float(heading_err)
+
+    def observe(self, state: np.ndarray, step: int) -> np.ndarray:
+        n = self._n_vars
+        obs = np.empty(n + 2, np.float32)
+        obs[:n] = state[self._obs_idx]
+        obs[n], obs[n + 1] = self.errors(state)
+        return obs
+
+    def task_reward(self, ctx: RewardContext) -> float:
+        alt_err, hdg_err = self.errors(ctx.state.values)
+        roll = ctx.state.values[_ROLL]
+        return (
+            0.5 * math.exp(-abs(alt_err) / 100.0)
+            + 0.3 * math.exp(-abs(hdg_err) / 5.0)
+            + 0.2 * math.exp(-abs(roll) / 5.0)
+            - SMOOTHNESS_WEIGHT * action_change(ctx.prev_action, ctx.action)
+        )
+
+
+# Task families by the short names the CLI and env ids use: (static, dynamic).
+TASK_FAMILIES: dict[str, tuple[type[Task], type[Task]]] = {
+    "altitude": (ReachStaticTargetAltitudeTask, ReachDynamicTargetAltitudeTask),
+    "roll": (ReachStaticTargetRollTask, ReachDynamicTargetRollTask),
+    "pitch": (ReachStaticTargetPitchTask, ReachDynamicTargetPitchTask),
+    "heading": (ReachStaticTargetHeadingTask, ReachDynamicTargetHeadingTask),
+    "airspeed": (ReachStaticTargetAirspeedTask, ReachDynamicTargetAirspeedTask),
+    "level": (LevelFlightTask, LevelFlightTask),
+    "dummy": (DummyTask, DummyTask),
+}
+assert set(FAMILIES) <= set(TASK_FAMILIES)
+
+
+def task_class(name: str, dynamic: bool = False) -> type[Task]:
+    """The task class for a family name (``altitude``, ``roll``, ...), static or dynamic."""
+    from gymfg_il.errors import ConfigError
+
+    try:
+        static, moving = TASK_FAMILIES[name]
+    except KeyError:
+        raise ConfigError(
+            f"unknown task {name!r}: choose one of {', '.join(TASK_FAMILIES)}"
+        ) from None
+    if dynamic and static is moving:
+        raise ConfigError(f"task {name!r} has no dynamic variant; drop --dynamic")
+    return moving if dynamic else static
