@@ -66,9 +66,9 @@ def _doc(summary: str, fam: object, dynamic: bool, unit: str) -> str:
     where = "an offset from the start value" if f.relative else "an absolute value"  # type: ignore[attr-defined]
     target = f"drawn per episode from [{low:g}, {high:g}] {unit}, {where}"
     if dynamic:
-        target += (
-            f"; then every hold_s (20 s) a new waypoint is drawn and the target moves towards "
-            f"it at {f.rate:g} {unit}/s"  # type: ignore[attr-defined]
+        target = (
+            f"starts at the start value and moves at {f.rate:g} {unit}/s towards waypoints "
+            f"drawn every hold_s (20 s) from [{low:g}, {high:g}] {unit}, {where}"  # type: ignore[attr-defined]
         )
     extra = "".join(f"and ``{v}`` " for v in f.extra_vars)  # type: ignore[attr-defined]
     return summary + _TARGET_DOC.format(

@@ -5,7 +5,8 @@ classes in ``gymfg_il.tasks.library`` are ``TargetTask`` with a family and a sta
 switch, nothing more.
 
 Dynamic targets follow a seeded schedule built at reset: every ``hold_s`` seconds a new waypoint
-is drawn from the target range, and the target moves towards it at the family's ``rate``.
+is drawn from the target range, and the target moves towards it at the family's ``rate``,
+starting from the variable's value at the start of the episode.
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ ALTITUDE = TargetFamily("altitude", "altitude_ft", True, (-1000.0, 1000.0), 200.
 ROLL = TargetFamily("roll", "roll_deg", False, (-30.0, 30.0), 5.0, 2.0, 5.0)
 PITCH = TargetFamily("pitch", "pitch_deg", False, (-4.0, 8.0), 2.0, 1.0, 1.0)
 HEADING = TargetFamily(
-    "heading", "heading_deg", True, (-90.0, 90.0), 10.0, 3.0, 3.0, True, ("heading_deg",)
+    "heading", "heading_deg", True, (-90.0, 90.0), 10.0, 3.0, 1.0, True, ("heading_deg",)
 )
 AIRSPEED = TargetFamily("airspeed", "airspeed_kts", True, (-20.0, 20.0), 5.0, 3.0, 1.0)
 FAMILIES: dict[str, TargetFamily] = {
@@ -141,16 +142,18 @@ class TargetTask(Task):
         if not self.dynamic:
             self._targets = np.full(n, self._absolute(first))
             return
-        # A rate-limited walk through seeded waypoints, in the family's offset convention.
+        # A rate-limited walk from the start value through seeded waypoints (the first one is
+        # ``target`` when given), in the family's offset convention.
         offsets = np.empty(n)
-        current, waypoint = first, first
+        current = 0.0 if self.family.relative else self.start_value
+        waypoint = first
         per_step = self.family.rate * self.dt
         hold = max(1, round(self.hold_s / self.dt))
         for i in range(n):
+            offsets[i] = current
             if i and i % hold == 0:
                 waypoint = self._draw(rng)
             current += max(-per_step, min(per_step, waypoint - current))
-            offsets[i] = current
         if self.family.relative:
             offsets += self.start_value
         self._targets = offsets % 360.0 if self.family.angular else offsets

@@ -1,0 +1,169 @@
+"""Physics-based controllers: PID loops, one per control surface, composed into autopilots.
+
+Loops (each a ``PID`` with explicit ``dt``):
+
+| surface | inner loop | outer loops |
+| --- | --- | --- |
+| elevator | pitch (damped by pitch rate) | climb rate -> pitch, altitude -> climb rate |
+| aileron | roll (damped by roll rate) | heading -> roll |
+| throttle | airspeed | |
+| rudder | sideslip -> 0 (coordinated flight) | |
+
+``Autopilot`` holds one target per axis (vertical: altitude, climb rate or pitch; lateral: roll
+or heading; speed: airspeed). Axes left without a target hold what they had at the first
+observation of the episode (altitude, wings level, airspeed), so every task's controller
+flies a complete aircraft. ``controller_for(task)`` builds the one that matches a task.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gymfg_il.controllers.gains import Gains, gains_for
+from gymfg_il.controllers.pid import PID
+from gymfg_il.errors import ConfigError
+from gymfg_il.tasks.orientation import bank_for_turn_rate
+
+_R2D = 57.29577951308232
+
+
+@dataclass(frozen=True)
+class Targets:
+    """Where each target comes from: an observation name, a constant, or None (hold start)."""
+
+    vertical: str = "altitude"  # "altitude", "pitch" or "climb"
+    vertical_source: str | float | None = None
+    lateral: str = "roll"  # "roll" or "heading"
+    lateral_source: str | float | None = 0.0
+    speed_source: str | float | None = None
+
+
+class Autopilot:
+    """Fly any aircraft by PID loops from a task observation with named entries.
+
+    Args:
+        observation_names: names of the observation's entries (``task.observation_names``).
+        model: JSBSim model, selects the gain set.
+        dt: seconds per agent step.
+        targets: which target each axis follows (``Targets``).
+        gains: override the model's gain set.
+    """
+
+    def __init__(
+        self,
+        observation_names: tuple[str, ...],
+        model: str,
+        dt: float,
+        targets: Targets = Targets(),
+        gains: Gains | None = None,
+    ) -> None:
+        if not dt > 0:
+            raise ConfigError(f"dt must be > 0 seconds, got {dt!r}")
+        self.names = tuple(observation_names)
+        self.index = {n: i for i, n in enumerate(self.names)}
+        need = ["altitude_ft", "vertical_speed_fps", "roll_deg", "pitch_deg", "airspeed_kts",
+                "p_rad_s", "q_rad_s", "beta_deg"]
+        if targets.lateral == "heading":
+            need.append("heading_deg")
+        for source in (targets.vertical_source, targets.lateral_source, targets.speed_source):
+            if isinstance(source, str):
+                need.append(source)
+        missing = [n for n in need if n not in self.index]
+        if missing:
+            raise ConfigError(f"the observation lacks {missing} that the autopilot reads")
+        self.model, self.dt, self.targets = model, dt, targets
+        g = self.gains = gains or gains_for(model)
+        self.pitch_pid = PID(*g.pitch)
+        self.roll_pid = PID(*g.roll)
+        self.climb_pid = PID(*g.climb, out_min=-g.max_pitch_deg, out_max=g.max_pitch_deg)
+        self.speed_pid = PID(*g.speed, out_min=0.0, out_max=1.0)
+        self.start: np.ndarray | None = None
+        self._last_heading_target: float | None = None
+        self.throttle_trim = 0.7
+
+    def reset(self, seed: int | None = None) -> None:
+        for pid in (self.pitch_pid, self.roll_pid, self.climb_pid, self.speed_pid):
+            pid.reset()
+        self.start = None
+        self._last_heading_target: float | None = None
+
+    def set_throttle_trim(self, throttle: float) -> None:
+        self.throttle_trim = throttle
+
+    def _value(self, obs: np.ndarray, source: str | float | None, hold: str) -> float:
+        if source is None:
+            assert self.start is not None
+            return float(self.start[self.index[hold]])
+        if isinstance(source, str):
+            return float(obs[self.index[source]])
+        return float(source)
+
+    def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        obs = np.asarray(observation, dtype=np.float64)
+        if self.start is None:
+            self.start = obs.copy()
+            self.speed_pid.bias = self.throttle_trim
+        i, g, t, dt = self.index, self.gains, self.targets, self.dt
+        # vertical: altitude -> climb rate -> pitch -> elevator (positive elevator = nose down)
+        if t.vertical == "pitch":
+            pitch_target = self._value(obs, t.vertical_source, "pitch_deg")
+        else:
+            if t.vertical == "climb":
+                climb_target = self._value(obs, t.vertical_source, "vertical_speed_fps")
+            else:
+                alt_error = self._value(obs, t.vertical_source, "altitude_ft") - obs[i["altitude_ft"]]
+                climb_target = g.altitude_to_climb * alt_error
+            climb_target = max(-g.max_descent_fps, min(g.max_climb_fps, climb_target))
+            pitch_target = self.climb_pid(climb_target, obs[i["vertical_speed_fps"]], dt)
+        pitch_target = max(-g.max_pitch_deg, min(g.max_pitch_deg, pitch_target))
+        nose_up = self.pitch_pid(pitch_target, obs[i["pitch_deg"]], dt, obs[i["q_rad_s"]] * _R2D)
+        # lateral: heading -> roll -> aileron
+        if t.lateral == "heading":
+            heading_target = self._value(obs, t.lateral_source, "heading_deg")
+            err = (heading_target - obs[i["heading_deg"]] + 180.0) % 360.0 - 180.0
+            # feed-forward: the bank of a coordinated turn at the target's own turn rate
+            last, self._last_heading_target = self._last_heading_target, heading_target
+            turn = 0.0 if last is None else ((heading_target - last + 180.0) % 360.0 - 180.0) / dt
+            roll_target = g.heading_to_roll * err + bank_for_turn_rate(
+                turn, obs[i["airspeed_kts"]])
+        else:
+            roll_target = self._value(obs, t.lateral_source, "roll_deg")
+        roll_target = max(-g.max_roll_deg, min(g.max_roll_deg, roll_target)) \
+            if t.lateral == "heading" else roll_target
+        aileron = self.roll_pid(roll_target, obs[i["roll_deg"]], dt, obs[i["p_rad_s"]] * _R2D)
+        # speed: airspeed -> throttle; rudder: sideslip -> 0
+        speed_target = self._value(obs, t.speed_source, "airspeed_kts")
+        throttle = self.speed_pid(speed_target, obs[i["airspeed_kts"]], dt)
+        rudder = max(-1.0, min(1.0, -g.sideslip * obs[i["beta_deg"]]))
+        return np.array([aileron, -nose_up, rudder, throttle])
+
+
+def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0.7) -> Autopilot:
+    """The autopilot that flies ``task`` (a bound Task): its target on the task's axis, the
+    other axes held at their start values."""
+    from gymfg_il.tasks.library import DummyTask, LevelFlightTask
+    from gymfg_il.tasks.targets import TargetTask
+
+    names = task.observation_names  # type: ignore[attr-defined]
+    if isinstance(task, TargetTask):
+        var = task.family.variable
+        source = f"{var}_target"
+        key = task.family.key
+        targets = {
+            "altitude": Targets(vertical="altitude", vertical_source=source),
+            "pitch": Targets(vertical="pitch", vertical_source=source),
+            "roll": Targets(lateral="roll", lateral_source=source),
+            "heading": Targets(lateral="heading", lateral_source=source),
+            "airspeed": Targets(speed_source=source),
+        }[key]
+    elif isinstance(task, LevelFlightTask):
+        targets = Targets(lateral="heading", lateral_source=None)
+    elif isinstance(task, DummyTask):
+        targets = Targets()
+    else:
+        raise ConfigError(f"no controller for {type(task).__name__}; build an Autopilot yourself")
+    pilot = Autopilot(names, model, dt, targets)
+    pilot.set_throttle_trim(throttle_trim)
+    return pilot

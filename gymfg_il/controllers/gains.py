@@ -1,0 +1,87 @@
+"""Gain sets per aircraft, tuned on JSBSim 1.3.3 at each aircraft's cruise profile.
+
+Angles are in degrees, rates in deg/s, speeds in kt and ft/s. Aircraft without their own set
+use ``GENERIC`` (a light-aircraft set).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Gains:
+    """Gains and limits of the autopilot loops.
+
+    Attributes:
+        pitch: (kp, ki, kd) elevator from pitch error (per deg, kd per deg/s of pitch rate).
+        roll: (kp, ki, kd) aileron from roll error (kd per deg/s of roll rate).
+        climb: (kp, ki, kd) pitch target (deg) from climb-rate error (ft/s).
+        altitude_to_climb: climb-rate target (ft/s) per ft of altitude error.
+        heading_to_roll: roll target (deg) per deg of heading error.
+        speed: (kp, ki, kd) throttle from airspeed error (per kt).
+        sideslip: rudder per deg of sideslip (drives sideslip to zero).
+        max_pitch_deg, max_roll_deg: attitude limits of the outer loops.
+        max_climb_fps, max_descent_fps: climb-rate limits of the altitude loop.
+    """
+
+    pitch: tuple[float, float, float]
+    roll: tuple[float, float, float]
+    climb: tuple[float, float, float]
+    altitude_to_climb: float
+    heading_to_roll: float
+    speed: tuple[float, float, float]
+    sideslip: float
+    max_pitch_deg: float
+    max_roll_deg: float
+    max_climb_fps: float
+    max_descent_fps: float
+
+
+GAINS: dict[str, Gains] = {
+    "c172p": Gains(
+        pitch=(0.08, 0.03, 0.03),
+        roll=(0.03, 0.004, 0.012),
+        climb=(0.5, 0.1, 0.0),
+        altitude_to_climb=0.12,
+        heading_to_roll=1.2,
+        speed=(0.05, 0.01, 0.0),
+        sideslip=0.05,
+        max_pitch_deg=15.0,
+        max_roll_deg=25.0,
+        max_climb_fps=15.0,
+        max_descent_fps=15.0,
+    ),
+    "f15": Gains(
+        pitch=(0.05, 0.03, 0.02),
+        roll=(0.02, 0.003, 0.006),
+        climb=(0.15, 0.03, 0.0),
+        altitude_to_climb=0.12,
+        heading_to_roll=1.2,
+        speed=(0.02, 0.004, 0.0),
+        sideslip=0.05,
+        max_pitch_deg=15.0,
+        max_roll_deg=30.0,
+        max_climb_fps=40.0,
+        max_descent_fps=40.0,
+    ),
+    "A320": Gains(
+        pitch=(0.06, 0.03, 0.03),
+        roll=(0.02, 0.003, 0.008),
+        climb=(0.15, 0.03, 0.0),
+        altitude_to_climb=0.1,
+        heading_to_roll=1.0,
+        speed=(0.03, 0.006, 0.0),
+        sideslip=0.05,
+        max_pitch_deg=12.0,
+        max_roll_deg=25.0,
+        max_climb_fps=30.0,
+        max_descent_fps=30.0,
+    ),
+}
+GENERIC = GAINS["c172p"]
+
+
+def gains_for(model: str) -> Gains:
+    """The gain set for a JSBSim model (the generic one when it has none of its own)."""
+    return GAINS.get(model, GENERIC)

@@ -1,0 +1,58 @@
+"""The controllers reach and hold their targets on each of the paper's aircraft."""
+
+import numpy as np
+import pytest
+
+from gymfg_il.controllers.autopilot import controller_for
+from gymfg_il.controllers.pid import PID
+from gymfg_il.envs.single import AircraftEnv
+from gymfg_il.errors import ConfigError
+
+CASES = [("altitude", 1000, 50), ("altitude", -1000, 50), ("roll", 30, 2), ("roll", -30, 2),
+         ("heading", 90, 3), ("airspeed", 15, 3), ("airspeed", -15, 3)]
+
+
+def fly(family, model, target, seconds=150, dynamic=False):
+    kwargs = {"target": target} if target is not None else {}
+    env = AircraftEnv(family, model, dynamic=dynamic, task_kwargs=kwargs, episode_time_s=seconds)
+    pilot = controller_for(env.task, env.aircraft.model, env.dt, env.aircraft.profile.cruise_throttle)
+    obs, _ = env.reset(seed=0)
+    pilot.reset(0)
+    errors, done = [], False
+    while not done:
+        obs, _, terminated, truncated, _ = env.step(pilot.act(obs))
+        errors.append(obs[-1])
+        done = terminated or truncated
+    env.close()
+    assert not terminated
+    return np.abs(np.array(errors))
+
+
+@pytest.mark.parametrize("model", ["c172p", "f15", "A320"])
+@pytest.mark.parametrize(("family", "target", "tolerance"), CASES)
+def test_controller_reaches_and_holds(model, family, target, tolerance):
+    errors = fly(family, model, target)
+    assert errors[0] > 10 * tolerance or family == "airspeed"  # a real manoeuvre
+    assert errors[-400:].max() < tolerance  # held for the last 40 s
+
+
+@pytest.mark.parametrize("model", ["c172p", "f15", "A320"])
+@pytest.mark.parametrize(("family", "bound"), [("altitude", 150), ("roll", 8), ("heading", 10)])
+def test_dynamic_targets_are_tracked_with_bounded_error(model, family, bound):
+    errors = fly(family, model, None, seconds=90, dynamic=True)
+    assert errors[300:].max() < bound
+
+
+def test_pid_anti_windup_and_derivative_on_measurement():
+    pid = PID(1.0, 1.0, 0.5, out_min=-1, out_max=1)
+    for _ in range(100):
+        out = pid(10.0, 0.0, 0.1)
+    assert out == 1.0 and pid.integral < 5  # saturated, integral did not wind up
+    pid.reset()
+    first = pid(0.0, 0.0, 0.1)
+    jumped = pid(5.0, 0.0, 0.1)  # setpoint jump: no derivative kick
+    assert first == 0.0 and jumped == pytest.approx(1.0)
+    with pytest.raises(ConfigError):
+        pid(0, 0, 0.0)
+    with pytest.raises(ConfigError):
+        PID(1.0, out_min=1, out_max=0)
