@@ -63,8 +63,16 @@ class Autopilot:
             raise ConfigError(f"dt must be > 0 seconds, got {dt!r}")
         self.names = tuple(observation_names)
         self.index = {n: i for i, n in enumerate(self.names)}
-        need = ["altitude_ft", "vertical_speed_fps", "roll_deg", "pitch_deg", "airspeed_kts",
-                "p_rad_s", "q_rad_s", "beta_deg"]
+        need = [
+            "altitude_ft",
+            "vertical_speed_fps",
+            "roll_deg",
+            "pitch_deg",
+            "airspeed_kts",
+            "p_rad_s",
+            "q_rad_s",
+            "beta_deg",
+        ]
         if targets.lateral == "heading":
             need.append("heading_deg")
         for source in (targets.vertical_source, targets.lateral_source, targets.speed_source):
@@ -87,7 +95,7 @@ class Autopilot:
         for pid in (self.pitch_pid, self.roll_pid, self.climb_pid, self.speed_pid):
             pid.reset()
         self.start = None
-        self._last_heading_target: float | None = None
+        self._last_heading_target = None
 
     def set_throttle_trim(self, throttle: float) -> None:
         self.throttle_trim = throttle
@@ -113,7 +121,8 @@ class Autopilot:
             if t.vertical == "climb":
                 climb_target = self._value(obs, t.vertical_source, "vertical_speed_fps")
             else:
-                alt_error = self._value(obs, t.vertical_source, "altitude_ft") - obs[i["altitude_ft"]]
+                alt_target = self._value(obs, t.vertical_source, "altitude_ft")
+                alt_error = alt_target - obs[i["altitude_ft"]]
                 climb_target = g.altitude_to_climb * alt_error
             climb_target = max(-g.max_descent_fps, min(g.max_climb_fps, climb_target))
             pitch_target = self.climb_pid(climb_target, obs[i["vertical_speed_fps"]], dt)
@@ -126,12 +135,14 @@ class Autopilot:
             # feed-forward: the bank of a coordinated turn at the target's own turn rate
             last, self._last_heading_target = self._last_heading_target, heading_target
             turn = 0.0 if last is None else ((heading_target - last + 180.0) % 360.0 - 180.0) / dt
-            roll_target = g.heading_to_roll * err + bank_for_turn_rate(
-                turn, obs[i["airspeed_kts"]])
+            roll_target = g.heading_to_roll * err + bank_for_turn_rate(turn, obs[i["airspeed_kts"]])
         else:
             roll_target = self._value(obs, t.lateral_source, "roll_deg")
-        roll_target = max(-g.max_roll_deg, min(g.max_roll_deg, roll_target)) \
-            if t.lateral == "heading" else roll_target
+        roll_target = (
+            max(-g.max_roll_deg, min(g.max_roll_deg, roll_target))
+            if t.lateral == "heading"
+            else roll_target
+        )
         aileron = self.roll_pid(roll_target, obs[i["roll_deg"]], dt, obs[i["p_rad_s"]] * _R2D)
         # speed: airspeed -> throttle; rudder: sideslip -> 0
         speed_target = self._value(obs, t.speed_source, "airspeed_kts")

@@ -62,7 +62,9 @@ class OfflineEnv:
         self.opponents: list[tuple[Team, list[Agent]]] = []
         for entry in opponents:
             if not (isinstance(entry, tuple) and len(entry) == 2 and isinstance(entry[0], Team)):
-                raise ConfigError(f"opponents entries must be (Team, [agents]) pairs, got {entry!r}")
+                raise ConfigError(
+                    f"opponents entries must be (Team, [agents]) pairs, got {entry!r}"
+                )
             team, agents = entry
             agents = list(agents)
             if len(agents) != len(team.roster):
@@ -72,7 +74,9 @@ class OfflineEnv:
                 )
             for agent in agents:
                 if not isinstance(agent, Agent):
-                    raise ConfigError(f"{agent!r} is not an Agent (needs reset(seed) and act(obs, opp))")
+                    raise ConfigError(
+                        f"{agent!r} is not an Agent (needs reset(seed) and act(obs, opp))"
+                    )
             self.opponents.append((team, agents))
         self._pool = SimPool(sim_hz, agent_hz)
         self.world: World | None = None
@@ -128,7 +132,9 @@ class OfflineEnv:
     ) -> tuple[TeamState, np.ndarray, np.ndarray, bool, bool, dict[str, Any]]:
         world, team = self.world, self.team
         if world is None or team is None or self._done:
-            raise EnvStateError("call env.reset(team) before step (and again after an episode ends)")
+            raise EnvStateError(
+                "call env.reset(team) before step (and again after an episode ends)"
+            )
         own = team_controls(team_actions, team.callsigns)
         actions: list[Controls | None] = list(own)
         for other, agents in self.opponents:
@@ -152,8 +158,14 @@ class OfflineEnv:
             "reasons": {s.callsign: s.reason for s in world.slots if s.reason},
             "opponent_callsigns": [s.callsign for s in world.opponents_of(team.name)],
         }
-        return self._team_state(), world.opponent_states(team.name), rewards, terminated, \
-            truncated, info
+        return (
+            self._team_state(),
+            world.opponent_states(team.name),
+            rewards,
+            terminated,
+            truncated,
+            info,
+        )
 
     def _team_state(self) -> TeamState:
         assert self.world is not None and self.team is not None

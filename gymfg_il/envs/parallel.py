@@ -22,7 +22,7 @@ from gymfg_il.errors import ActionError, EnvStateError
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW, BY_NAME
 
 
-class GymFGParallelEnv(ParallelEnv):  # type: ignore[misc]
+class GymFGParallelEnv(ParallelEnv):
     """Teams of aircraft as a PettingZoo ParallelEnv; build it with ``parallel_env``."""
 
     metadata = {"name": "gymfg_parallel_v0", "render_modes": []}  # noqa: RUF012
@@ -86,7 +86,8 @@ class GymFGParallelEnv(ParallelEnv):  # type: ignore[misc]
         world = self.world
         ctrl: list[Controls | None] = [
             controls(actions[s.callsign], f"action of {s.callsign!r}")
-            if s.callsign in self.agents else None
+            if s.callsign in self.agents
+            else None
             for s in world.slots
         ]
         world.advance(ctrl)
@@ -115,6 +116,9 @@ def parallel_env(
     scenario: Any = None,
 ) -> GymFGParallelEnv:
     """A PettingZoo ParallelEnv over ``teams`` (every aircraft an agent, named by callsign)."""
-    config = EnvConfig(sim_hz, agent_hz, scenario=scenario) if opponent_view is None else \
-        EnvConfig(sim_hz, agent_hz, tuple(opponent_view), scenario)
+    config = (
+        EnvConfig(sim_hz, agent_hz, scenario=scenario)
+        if opponent_view is None
+        else EnvConfig(sim_hz, agent_hz, tuple(opponent_view), scenario)
+    )
     return GymFGParallelEnv(teams, config)

@@ -13,10 +13,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from gymfg_il.aircraft import Aircraft
+from gymfg_il.envs.world import Scenario as JointStart
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.tasks.geometry import offset_position
-from gymfg_il.envs.world import Scenario as JointStart
 
 
 def _check(**values: float) -> None:
@@ -83,7 +83,7 @@ def head_on_merge(
             ours = team == first_team
             k = counts[ours]
             counts[ours] += 1
-            north = (-distance_ft / 2 if ours else distance_ft / 2)
+            north = -distance_ft / 2 if ours else distance_ft / 2
             north += float(rng.uniform(-1, 1)) * jitter_ft
             east = k * lateral_spacing_ft + float(rng.uniform(-1, 1)) * jitter_ft
             lat, lon = offset_position(origin.latitude_deg, origin.longitude_deg, north, east)

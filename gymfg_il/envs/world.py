@@ -56,7 +56,9 @@ class EnvConfig:
         if len(set(view)) != len(view):
             raise ConfigError(f"opponent_view lists a variable twice: {view}")
         if self.scenario is not None and not callable(self.scenario):
-            raise ConfigError(f"scenario must be callable (rng, aircraft) -> ics, got {self.scenario!r}")
+            raise ConfigError(
+                f"scenario must be callable (rng, aircraft) -> ics, got {self.scenario!r}"
+            )
 
     @property
     def dt(self) -> float:
@@ -112,18 +114,23 @@ class Slot:
         self.aircraft = aircraft
         self.task = task
         self.sim = sim
-        self.state = np.zeros(len(NAMES))
-        self.prev_state = self.state
-        self.action = np.zeros(4)
-        self.prev_action = self.action
+        self.state: np.ndarray = np.zeros(len(NAMES), dtype=np.float64)
+        self.prev_state: np.ndarray = self.state
+        self.action: np.ndarray = np.zeros(4)
+        self.prev_action: np.ndarray = self.action
         self.reward = 0.0
         self.terminated = False
         self.reason: str | None = None
         self.history: deque[tuple[np.ndarray, np.ndarray]] = deque(
             maxlen=max(task.history_window, 1)
         )
-        self.ctx = RewardContext(StateView(self.state), StateView(self.state), self.action,
-                                 self.action, history=self.history)
+        self.ctx = RewardContext(
+            StateView(self.state),
+            StateView(self.state),
+            self.action,
+            self.action,
+            history=self.history,
+        )
         # (view to refresh, source slot, restricted to the opponent view?)
         self.target_links: list[tuple[StateView, Slot, bool]] = []
 
@@ -171,8 +178,11 @@ class World:
                             f"{target!r}, which is not in this simulation"
                         )
                     restricted = source.team != slot.team
-                    view = StateView(source.state[self.view_idx], view_names) if restricted \
+                    view = (
+                        StateView(source.state[self.view_idx], view_names)
+                        if restricted
                         else StateView(source.state)
+                    )
                     slot.ctx.targets[target.callsign] = view
                     slot.target_links.append((view, source, restricted))
 

@@ -32,8 +32,8 @@ class StateVar:
 CATALOGUE: tuple[StateVar, ...] = (
     StateVar("lat_deg", "position/lat-geod-deg", "deg", -90.0, 90.0, "geodetic latitude"),
     StateVar("lon_deg", "position/long-gc-deg", "deg", -180.0, 180.0, "longitude"),
-    StateVar("altitude_ft", "position/h-sl-ft", "ft", -2000.0, 100000.0, "altitude above sea level"),
-    StateVar("altitude_agl_ft", "position/h-agl-ft", "ft", -2000.0, 100000.0, "height above ground"),
+    StateVar("altitude_ft", "position/h-sl-ft", "ft", -2000.0, 1e5, "altitude above sea level"),
+    StateVar("altitude_agl_ft", "position/h-agl-ft", "ft", -2000.0, 1e5, "height above ground"),
     StateVar("roll_deg", "attitude/phi-deg", "deg", -180.0, 180.0, "roll (bank) angle"),
     StateVar("pitch_deg", "attitude/theta-deg", "deg", -90.0, 90.0, "pitch angle"),
     StateVar("heading_deg", "attitude/psi-deg", "deg", 0.0, 360.0, "true heading"),
@@ -49,8 +49,14 @@ CATALOGUE: tuple[StateVar, ...] = (
     StateVar("alpha_deg", "aero/alpha-deg", "deg", -180.0, 180.0, "angle of attack"),
     StateVar("beta_deg", "aero/beta-deg", "deg", -180.0, 180.0, "sideslip angle"),
     StateVar("mach", "velocities/mach", "1", 0.0, 5.0, "Mach number"),
-    StateVar("load_factor_g", "accelerations/n-pilot-z-norm", "g", -20.0, 20.0,
-             "normal load factor at the pilot (positive down)"),
+    StateVar(
+        "load_factor_g",
+        "accelerations/n-pilot-z-norm",
+        "g",
+        -20.0,
+        20.0,
+        "normal load factor at the pilot (positive down)",
+    ),
     StateVar("aileron_cmd", "fcs/aileron-cmd-norm", "1", -1.0, 1.0, "aileron command"),
     StateVar("elevator_cmd", "fcs/elevator-cmd-norm", "1", -1.0, 1.0, "elevator command"),
     StateVar("rudder_cmd", "fcs/rudder-cmd-norm", "1", -1.0, 1.0, "rudder command"),
@@ -91,8 +97,10 @@ def indices(names: tuple[str, ...] | list[str]) -> np.ndarray:
 
 def describe() -> str:
     """The catalogue as a Markdown table."""
-    rows = [f"| {v.name} | `{v.prop}` | {v.unit} | [{v.low:g}, {v.high:g}] | {v.description} |"
-            for v in CATALOGUE]
+    rows = [
+        f"| {v.name} | `{v.prop}` | {v.unit} | [{v.low:g}, {v.high:g}] | {v.description} |"
+        for v in CATALOGUE
+    ]
     head = "| name | JSBSim property | unit | bounds | meaning |\n| --- | --- | --- | --- | --- |"
     return "\n".join([head, *rows])
 

@@ -13,6 +13,7 @@ import os
 import shutil
 import tempfile
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -74,23 +75,22 @@ class Simulation:
         pm = fdm.get_property_manager()
         self.engines = max(1, fdm.get_propulsion().get_num_engines())
 
-        def node(prop: str) -> object:
+        def node(prop: str) -> Any:  # a JSBSim FGPropertyNode
             n = pm.get_node(prop, True) if not pm.hasNode(prop) else pm.get_node(prop)
             if n is None:
                 raise RuntimeError(f"JSBSim model {self.model!r} has no property {prop!r}")
             return n
 
         self._getters: list[Callable[[], float]] = [
-            node(v.prop).get_double_value for v in catalogue  # type: ignore[attr-defined]
+            node(v.prop).get_double_value for v in catalogue
         ]
         setters = [
-            node(p).set_double_value  # type: ignore[attr-defined]
+            node(p).set_double_value
             for p in ("fcs/aileron-cmd-norm", "fcs/elevator-cmd-norm", "fcs/rudder-cmd-norm")
         ]
         self._set_aileron, self._set_elevator, self._set_rudder = setters
         self._set_throttles: list[Callable[[float], None]] = [
-            node(f"fcs/throttle-cmd-norm[{i}]").set_double_value  # type: ignore[attr-defined]
-            for i in range(self.engines)
+            node(f"fcs/throttle-cmd-norm[{i}]").set_double_value for i in range(self.engines)
         ]
         self._mixtures = [f"fcs/mixture-cmd-norm[{i}]" for i in range(self.engines)]
         self._has_gear = pm.hasNode("gear/gear-cmd-norm")

@@ -43,8 +43,8 @@ __all__ = [
     "ReachStaticTargetRollTask",
     "RewardContext",
     "RewardFn",
-    "Task",
     "TargetFamily",
     "TargetTask",
+    "Task",
     "task_class",
 ]

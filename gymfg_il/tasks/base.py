@@ -11,10 +11,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from gymfg_il.aircraft import Aircraft
+from gymfg_il.aircraft import Aircraft, FlightProfile
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
-from gymfg_il.aircraft import FlightProfile
 from gymfg_il.sim.properties import BY_NAME, INDEX, indices
 from gymfg_il.tasks.rewards import RewardContext, RewardFn
 
@@ -61,8 +60,10 @@ class Task:
     ) -> None:
         if reward is not None and not callable(reward):
             raise ConfigError(f"reward must be callable (a RewardFn), got {reward!r}")
-        if isinstance(history_window, bool) or not isinstance(history_window, int) or (
-            history_window < 0
+        if (
+            isinstance(history_window, bool)
+            or not isinstance(history_window, int)
+            or (history_window < 0)
         ):
             raise ConfigError(f"history_window must be an integer >= 0, got {history_window!r}")
         self._custom_reward = reward
@@ -138,7 +139,7 @@ class Task:
     def termination(self, state: np.ndarray) -> str | None:
         """Why the aircraft must stop now (crashed, stalled, ...), or None to go on."""
         agl = state[_AGL]
-        if not agl == agl or not state[_VC] == state[_VC]:
+        if agl != agl or state[_VC] != state[_VC]:
             return "diverged"
         if agl < self._min_agl:
             return "crashed"
@@ -156,4 +157,3 @@ class Task:
         if self.aircraft is None:
             raise ConfigError(f"{type(self).__name__} is not bound to an aircraft yet")
         return self.aircraft.profile
-

@@ -35,6 +35,7 @@ from gymfg_il.tasks.targets import (
     PITCH,
     ROLL,
     SMOOTHNESS_WEIGHT,
+    TargetFamily,
     TargetTask,
 )
 
@@ -60,24 +61,22 @@ _TARGET_DOC = """
     """
 
 
-def _doc(summary: str, fam: object, dynamic: bool, unit: str) -> str:
-    f = fam  # a TargetFamily
-    low, high = f.target_range  # type: ignore[attr-defined]
-    where = "an offset from the start value" if f.relative else "an absolute value"  # type: ignore[attr-defined]
+def _doc(summary: str, f: TargetFamily, dynamic: bool, unit: str) -> str:
+    low, high = f.target_range
+    where = "an offset from the start value" if f.relative else "an absolute value"
     target = f"drawn per episode from [{low:g}, {high:g}] {unit}, {where}"
     if dynamic:
         target = (
             f"starts at the start value and moves at {f.rate:g} {unit}/s towards waypoints "
-            f"drawn every hold_s (20 s) from [{low:g}, {high:g}] {unit}, {where}"  # type: ignore[attr-defined]
+            f"drawn every hold_s (20 s) from [{low:g}, {high:g}] {unit}, {where}"
         )
-    extra = "".join(f"and ``{v}`` " for v in f.extra_vars)  # type: ignore[attr-defined]
     return summary + _TARGET_DOC.format(
-        extra=extra,
-        var=f.variable,  # type: ignore[attr-defined]
+        extra="".join(f"and ``{v}`` " for v in f.extra_vars),
+        var=f.variable,
         unit=unit,
-        wrap=", wrapped to [-180, 180)" if f.angular else "",  # type: ignore[attr-defined]
+        wrap=", wrapped to [-180, 180)" if f.angular else "",
         target=target,
-        scale=f.reward_scale,  # type: ignore[attr-defined]
+        scale=f.reward_scale,
     )
 
 

@@ -57,9 +57,7 @@ HEADING = TargetFamily(
     "heading", "heading_deg", True, (-90.0, 90.0), 10.0, 3.0, 1.0, True, ("heading_deg",)
 )
 AIRSPEED = TargetFamily("airspeed", "airspeed_kts", True, (-20.0, 20.0), 5.0, 3.0, 1.0)
-FAMILIES: dict[str, TargetFamily] = {
-    f.key: f for f in (ALTITUDE, ROLL, PITCH, HEADING, AIRSPEED)
-}
+FAMILIES: dict[str, TargetFamily] = {f.key: f for f in (ALTITUDE, ROLL, PITCH, HEADING, AIRSPEED)}
 
 SMOOTHNESS_WEIGHT = 0.05
 
@@ -109,7 +107,7 @@ class TargetTask(Task):
         self.fixed_target = target
         self.hold_s = float(hold_s)
         self._var = INDEX[fam.variable]
-        self._targets = np.zeros(1)
+        self._targets: np.ndarray = np.zeros(1)
         self.start_value = 0.0
 
     @property

@@ -8,14 +8,23 @@ from gymfg_il.controllers.pid import PID
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.errors import ConfigError
 
-CASES = [("altitude", 1000, 50), ("altitude", -1000, 50), ("roll", 30, 2), ("roll", -30, 2),
-         ("heading", 90, 3), ("airspeed", 15, 3), ("airspeed", -15, 3)]
+CASES = [
+    ("altitude", 1000, 50),
+    ("altitude", -1000, 50),
+    ("roll", 30, 2),
+    ("roll", -30, 2),
+    ("heading", 90, 3),
+    ("airspeed", 15, 3),
+    ("airspeed", -15, 3),
+]
 
 
 def fly(family, model, target, seconds=150, dynamic=False):
     kwargs = {"target": target} if target is not None else {}
     env = AircraftEnv(family, model, dynamic=dynamic, task_kwargs=kwargs, episode_time_s=seconds)
-    pilot = controller_for(env.task, env.aircraft.model, env.dt, env.aircraft.profile.cruise_throttle)
+    pilot = controller_for(
+        env.task, env.aircraft.model, env.dt, env.aircraft.profile.cruise_throttle
+    )
     obs, _ = env.reset(seed=0)
     pilot.reset(0)
     errors, done = [], False

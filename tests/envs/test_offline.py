@@ -20,10 +20,12 @@ def paper_loop(env, team, agents, seed=0):
         agent.reset(seed)
     done, steps, rewards = False, 0, []
     while not done:
-        team_actions = [agent.act(s, opponent_states)
-                        for s, agent in zip(team_state, agents, strict=True)]
+        team_actions = [
+            agent.act(s, opponent_states) for s, agent in zip(team_state, agents, strict=True)
+        ]
         team_state, opponent_states, r, terminated, truncated, info = env.step(
-            np.hstack(team_actions))
+            np.hstack(team_actions)
+        )
         rewards.append(r)
         done = terminated or truncated
         steps += 1
@@ -33,14 +35,23 @@ def paper_loop(env, team, agents, seed=0):
 def level_pilots(env, team):
     pilots = []
     for slot in env.world.team_slots[team.name]:
-        pilots.append(controller_for(slot.task, slot.aircraft.model, env.dt,
-                                     slot.aircraft.profile.cruise_throttle))
+        pilots.append(
+            controller_for(
+                slot.task, slot.aircraft.model, env.dt, slot.aircraft.profile.cruise_throttle
+            )
+        )
     return pilots
 
 
 def test_paper_loop_runs_a_90_s_episode_with_the_three_paper_aircraft():
-    team = Team("red", [(f15("red-one"), LevelFlightTask), (c172p("red-two"), LevelFlightTask),
-                        (a320("red-three"), LevelFlightTask)])
+    team = Team(
+        "red",
+        [
+            (f15("red-one"), LevelFlightTask),
+            (c172p("red-two"), LevelFlightTask),
+            (a320("red-three"), LevelFlightTask),
+        ],
+    )
     blue = Team("blue", [(c172p("blue-one"), DummyTask)])
     env = OfflineEnv([(blue, [ConstantAgent()])])
     env.reset(team, seed=0)
@@ -62,8 +73,7 @@ def test_opponents_see_only_position_and_orientation():
     blue_state = env.world.by_callsign["blue-one"].state
     idx = [0, 1, 2, 4, 5, 6]  # lat, lon, alt, roll, pitch, heading in the catalogue
     assert np.array_equal(opp[0], blue_state[idx])
-    env2 = OfflineEnv([(blue, [ConstantAgent(), ConstantAgent()])],
-                      opponent_view=("altitude_ft",))
+    env2 = OfflineEnv([(blue, [ConstantAgent(), ConstantAgent()])], opponent_view=("altitude_ft",))
     _, opp2 = env2.reset(red, seed=1)
     assert opp2.shape == (2, 1)
 
@@ -76,28 +86,41 @@ def test_reward_targets_see_teammates_fully_and_opponents_restricted():
         return 0.0
 
     spying = functools.partial(DummyTask, reward=spy)
-    red = Team("red", [(f15("red-one"), spying), (f15("red-two"), DummyTask)],
-               reward_function_targets={f15("red-one"): [f15("red-two"), c172p("blue-one")]})
+    red = Team(
+        "red",
+        [(f15("red-one"), spying), (f15("red-two"), DummyTask)],
+        reward_function_targets={f15("red-one"): [f15("red-two"), c172p("blue-one")]},
+    )
     blue = Team("blue", [(c172p("blue-one"), DummyTask)])
     env = OfflineEnv([(blue, [ConstantAgent()])])
     env.reset(red, seed=0)
     env.step(np.hstack([[0, 0, 0, 0.8], [0, 0, 0, 0.8]]))
     assert "airspeed_kts" in seen["red-two"]
-    assert seen["blue-one"] == ("lat_deg", "lon_deg", "altitude_ft", "roll_deg", "pitch_deg",
-                                "heading_deg")
+    assert seen["blue-one"] == (
+        "lat_deg",
+        "lon_deg",
+        "altitude_ft",
+        "roll_deg",
+        "pitch_deg",
+        "heading_deg",
+    )
 
 
 def test_reward_target_outside_the_simulation_is_refused():
-    red = Team("red", [(f15("red-one"), DummyTask)],
-               reward_function_targets={f15("red-one"): [f15("ghost")]})
+    red = Team(
+        "red",
+        [(f15("red-one"), DummyTask)],
+        reward_function_targets={f15("red-one"): [f15("ghost")]},
+    )
     with pytest.raises(ConfigError, match="ghost"):
         OfflineEnv().reset(red)
 
 
 def test_history_window_reaches_the_reward():
     lengths = []
-    task = functools.partial(DummyTask, history_window=5,
-                             reward=lambda ctx: lengths.append(len(ctx.history)) or 0.0)
+    task = functools.partial(
+        DummyTask, history_window=5, reward=lambda ctx: lengths.append(len(ctx.history)) or 0.0
+    )
     red = Team("red", [(c172p("one"), task)])
     env = OfflineEnv()
     env.reset(red, seed=0)
@@ -113,8 +136,9 @@ def test_crashing_aircraft_terminates_cleanly_and_others_fly_on():
     env.reset(red, seed=0, options={"initial_conditions": {"diver": low}})
     terminated = False
     for _ in range(300):
-        _, _, rewards, terminated, truncated, info = env.step(
-            np.hstack([[0, 1.0, 0, 0.0], [0, 0, 0, 0.8]]))
+        _, _, rewards, terminated, _truncated, info = env.step(
+            np.hstack([[0, 1.0, 0, 0.0], [0, 0, 0, 0.8]])
+        )
         if info["terminated"][0]:
             break
     assert info["reasons"] == {"diver": "crashed"}
@@ -143,13 +167,16 @@ def test_same_seed_and_actions_give_identical_trajectories():
         assert np.array_equal(first[0], other[0]) and np.array_equal(first[1], other[1])
 
 
-@pytest.mark.parametrize("action, match", [
-    ([0, 0, 0], "shape"),
-    ([[0, 0, 0, 0.5]] * 2, "shape"),
-    ([0, float("nan"), 0, 0.5], "elevator=nan"),
-    ([0, 0, float("inf"), 0.5], "rudder=inf"),
-    (["a", 0, 0, 0], "not an array of numbers"),
-])
+@pytest.mark.parametrize(
+    "action, match",
+    [
+        ([0, 0, 0], "shape"),
+        ([[0, 0, 0, 0.5]] * 2, "shape"),
+        ([0, float("nan"), 0, 0.5], "elevator=nan"),
+        ([0, 0, float("inf"), 0.5], "rudder=inf"),
+        (["a", 0, 0, 0], "not an array of numbers"),
+    ],
+)
 def test_bad_actions_never_reach_jsbsim(action, match):
     red = Team("red", [(c172p("one"), DummyTask)])
     env = OfflineEnv()
@@ -192,19 +219,22 @@ def test_smallest_episode_time_throttles_all_teams():
 
 
 def test_formation_scenario_places_aircraft_jointly():
-    red = Team("red", [(c172p("lead"), DummyTask), (c172p("wing"), DummyTask),
-                       (c172p("slot"), DummyTask)])
+    red = Team(
+        "red", [(c172p("lead"), DummyTask), (c172p("wing"), DummyTask), (c172p("slot"), DummyTask)]
+    )
     env = OfflineEnv(scenario=formation(spacing_ft=300, jitter_ft=20))
     env.reset(red, seed=4)
     views = [env.world.by_callsign[c] for c in ("lead", "wing", "slot")]
     from gymfg_il.sim.properties import StateView
+
     lead, wing, slot = (StateView(v.state) for v in views)
     assert geometry.distance_ft(lead, wing) == pytest.approx(300 * 2**0.5, abs=60)
     assert geometry.distance_ft(lead, slot) == pytest.approx(600 * 2**0.5, abs=60)
     assert wing.heading_deg == pytest.approx(lead.heading_deg, abs=1e-3)
     env.reset(seed=4)
-    assert geometry.distance_ft(StateView(views[0].state), StateView(views[1].state)) == \
-        pytest.approx(geometry.distance_ft(lead, wing), abs=1e-6)
+    assert geometry.distance_ft(
+        StateView(views[0].state), StateView(views[1].state)
+    ) == pytest.approx(geometry.distance_ft(lead, wing), abs=1e-6)
 
 
 def test_head_on_merge_points_teams_at_each_other():
@@ -213,6 +243,7 @@ def test_head_on_merge_points_teams_at_each_other():
     env = OfflineEnv([(blue, [ConstantAgent()])], scenario=head_on_merge(distance_ft=20000))
     env.reset(red, seed=0)
     from gymfg_il.sim.properties import StateView
+
     r = StateView(env.world.by_callsign["red-one"].state)
     b = StateView(env.world.by_callsign["blue-one"].state)
     assert geometry.distance_ft(r, b) == pytest.approx(20000, rel=0.01)

@@ -26,6 +26,6 @@ def test_agents_see_their_task_and_the_other_team():
     assert obs["red-two"]["observation"].shape == (12,)
     steps = 0
     while env.agents:
-        obs, rewards, terms, truncs, _ = env.step({a: np.array([0, 0, 0, 0.8]) for a in env.agents})
+        *_, truncs, _ = env.step(dict.fromkeys(env.agents, np.array([0, 0, 0, 0.8])))
         steps += 1
     assert steps == 300 and all(truncs.values())

@@ -17,9 +17,14 @@ def test_check_env_passes_for_every_registered_id(env_id):
 
 
 def test_make_kwargs_select_aircraft_dynamic_and_ranges():
-    env = gym.make("GymFG/Roll-v0", aircraft="f15", dynamic=True,
-                   task_kwargs={"target_range": (10, 10)}, agent_hz=20)
-    obs, info = env.reset(seed=0)
+    env = gym.make(
+        "GymFG/Roll-v0",
+        aircraft="f15",
+        dynamic=True,
+        task_kwargs={"target_range": (10, 10)},
+        agent_hz=20,
+    )
+    _obs, info = env.reset(seed=0)
     assert env.unwrapped.aircraft.model == "f15"
     assert env.unwrapped.dt == 0.05
     assert info["target"] == pytest.approx(0, abs=1e-9)  # starts at the start roll...
@@ -39,8 +44,9 @@ def trajectory(env, seed, actions):
 
 
 def test_same_seed_and_actions_are_bit_identical(make_env):
-    actions = np.random.default_rng(0).uniform([-0.3, -0.3, -0.3, 0.5], [0.3, 0.3, 0.3, 1.0],
-                                               (200, 4))
+    actions = np.random.default_rng(0).uniform(
+        [-0.3, -0.3, -0.3, 0.5], [0.3, 0.3, 0.3, 1.0], (200, 4)
+    )
     env = make_env("heading", "c172p", dynamic=True)
     a = trajectory(env, 5, actions)
     trajectory(env, 6, actions[::-1])
@@ -54,8 +60,9 @@ def test_same_seed_and_actions_are_bit_identical(make_env):
 
 def test_reset_options(make_env):
     env = make_env("altitude")
-    _, info = env.reset(seed=0, options={"target": 300,
-                                         "initial_conditions": InitialConditions(altitude_ft=6000)})
+    _, info = env.reset(
+        seed=0, options={"target": 300, "initial_conditions": InitialConditions(altitude_ft=6000)}
+    )
     assert info["target"] == pytest.approx(6000 + 300, abs=1)
     with pytest.raises(ConfigError, match="unknown reset options"):
         env.reset(options={"targte": 1})
@@ -74,6 +81,7 @@ def test_time_limit_is_in_seconds(make_env):
 def test_bad_env_arguments():
     from gymfg_il.envs.single import AircraftEnv
     from gymfg_il.errors import RateError, UnknownAircraftError
+
     with pytest.raises(RateError):
         AircraftEnv("altitude", agent_hz=7)
     with pytest.raises(UnknownAircraftError):

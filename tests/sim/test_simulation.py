@@ -34,8 +34,16 @@ def test_reused_instance_repeats_a_fresh_one_bit_for_bit(model, kts):
 
 def test_initial_conditions_are_applied():
     sim = Simulation("c172p")
-    state = sim.reset(InitialConditions(latitude_deg=45.0, longitude_deg=7.0, altitude_ft=8000,
-                                        heading_deg=270, airspeed_kts=100), 0.7)
+    state = sim.reset(
+        InitialConditions(
+            latitude_deg=45.0,
+            longitude_deg=7.0,
+            altitude_ft=8000,
+            heading_deg=270,
+            airspeed_kts=100,
+        ),
+        0.7,
+    )
     assert state[INDEX["lat_deg"]] == pytest.approx(45.0, abs=1e-6)
     assert state[INDEX["lon_deg"]] == pytest.approx(7.0, abs=1e-6)
     assert state[INDEX["altitude_ft"]] == pytest.approx(8000, abs=1.0)

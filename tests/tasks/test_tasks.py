@@ -26,8 +26,9 @@ def state(**values):
     return s
 
 
-@pytest.mark.parametrize("cls", sorted({c for pair in TASK_FAMILIES.values() for c in pair},
-                                       key=lambda c: c.__name__))
+@pytest.mark.parametrize(
+    "cls", sorted({c for pair in TASK_FAMILIES.values() for c in pair}, key=lambda c: c.__name__)
+)
 def test_every_task_docstring_is_its_spec(cls):
     doc = cls.__doc__ or ""
     for part in ("Observation", "Reward", "Start and end"):
@@ -71,12 +72,17 @@ def test_reward_is_one_lambda_over_states_and_targets():
         prev_state=StateView(state(altitude_ft=4990)),
         action=np.array([0, 0, 0, 0.7]),
         prev_action=np.array([0, 0, 0, 0.7]),
-        targets={"red-two": StateView(np.array([0.0, 0.0, 5200.0]),
-                                      ("lat_deg", "lon_deg", "altitude_ft"))},
+        targets={
+            "red-two": StateView(
+                np.array([0.0, 0.0, 5200.0]), ("lat_deg", "lon_deg", "altitude_ft")
+            )
+        },
     )
     task = tasks.DummyTask(
-        reward=lambda c: -geometry.altitude_difference_ft(c.state, c.targets["red-two"])
-        + (c.state.altitude_ft - c.prev_state.altitude_ft)
+        reward=lambda c: (
+            -geometry.altitude_difference_ft(c.state, c.targets["red-two"])
+            + (c.state.altitude_ft - c.prev_state.altitude_ft)
+        )
     )
     assert task.reward(ctx) == pytest.approx(-200 + 10)
     assert tasks.DummyTask().reward(ctx) == 0.0
@@ -88,8 +94,9 @@ def test_target_reward_peaks_at_the_target():
     a = np.array([0, 0, 0, 0.7])
 
     def r(roll):
-        return task.reward(rewards.RewardContext(StateView(state(roll_deg=roll)),
-                                                 StateView(state()), a, a))
+        return task.reward(
+            rewards.RewardContext(StateView(state(roll_deg=roll)), StateView(state()), a, a)
+        )
 
     assert r(30) == pytest.approx(1.0)
     assert r(25) == pytest.approx(math.exp(-1))
@@ -118,9 +125,17 @@ def test_geometry_and_orientation():
     assert orientation.bank_for_turn_rate(3, 110) == pytest.approx(16.9, abs=0.3)
 
 
-@pytest.mark.parametrize("bad", [{"target_range": (5, -5)}, {"target": float("inf")},
-                                 {"hold_s": 0}, {"reward_scale": -1}, {"history_window": -1},
-                                 {"reward": 3}])
+@pytest.mark.parametrize(
+    "bad",
+    [
+        {"target_range": (5, -5)},
+        {"target": float("inf")},
+        {"hold_s": 0},
+        {"reward_scale": -1},
+        {"history_window": -1},
+        {"reward": 3},
+    ],
+)
 def test_bad_task_arguments(bad):
     with pytest.raises(ConfigError):
         tasks.ReachDynamicTargetAltitudeTask(**bad)

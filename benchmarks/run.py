@@ -1,0 +1,158 @@
+"""Side-by-side benchmarks, printed as ratios against their references in one run.
+
+    python benchmarks/run.py [--quick] [--json PATH]
+
+Rows (name, value, unit, target, higher_is_better):
+- env_step_vs_raw_jsbsim: steps/s of ``AircraftEnv.step`` (c172p, altitude task, 10 Hz = 12
+  JSBSim frames) divided by steps/s of a bare loop doing the same property I/O (the four
+  controls set through cached nodes, 12 ``FGFDMExec.run()``, the catalogue read into an array).
+- per_aircraft_8_vs_1: aircraft-steps/s of an OfflineEnv team of 8 c172p divided by that of a
+  team of 1.
+
+Each side is timed in alternating rounds and the best round of each is compared, so a busy
+moment on the machine does not land on one side only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+
+def best_rate(fns: dict[str, Callable[[int], None]], steps: int, rounds: int) -> dict[str, float]:
+    """Steps per second of each function, best of ``rounds`` alternating rounds."""
+    best = dict.fromkeys(fns, 0.0)
+    for _ in range(rounds):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn(steps)
+            best[name] = max(best[name], steps / (time.perf_counter() - t0))
+    return best
+
+
+def env_vs_raw(steps: int, rounds: int) -> dict[str, float]:
+    from gymfg_il.envs.single import AircraftEnv
+    from gymfg_il.sim.initial import InitialConditions
+    from gymfg_il.sim.simulation import Simulation
+
+    env = AircraftEnv("altitude", "c172p")
+    ic = InitialConditions(altitude_ft=5000, airspeed_kts=110)
+    action = np.array([0.0, 0.0, 0.0, 0.75], np.float32)
+
+    def run_env(n: int) -> None:
+        env.reset(seed=0, options={"initial_conditions": ic})
+        step = env.step
+        for _ in range(n):
+            step(action)
+
+    # The reference: the same JSBSim model and I/O with nothing around it.
+    sim = Simulation("c172p")
+    fdm = sim.fdm
+    pm = fdm.get_property_manager()
+    setters = [
+        pm.get_node(p).set_double_value
+        for p in (
+            "fcs/aileron-cmd-norm",
+            "fcs/elevator-cmd-norm",
+            "fcs/rudder-cmd-norm",
+            "fcs/throttle-cmd-norm",
+        )
+    ]
+    getters = list(sim._getters)
+    run = fdm.run
+    values = (0.0, 0.0, 0.0, 0.75)
+
+    def run_raw(n: int) -> None:
+        sim.reset(ic, 0.75)
+        for _ in range(n):
+            for setter, v in zip(setters, values, strict=True):
+                setter(v)
+            for _ in range(12):
+                run()
+            np.array([g() for g in getters])
+
+    rates = best_rate({"env": run_env, "raw": run_raw}, steps, rounds)
+    return {"env": rates["env"], "raw": rates["raw"], "ratio": rates["env"] / rates["raw"]}
+
+
+def eight_vs_one(steps: int, rounds: int) -> dict[str, float]:
+    from gymfg_il import Team
+    from gymfg_il.aircraft import c172p
+    from gymfg_il.envs import OfflineEnv
+    from gymfg_il.tasks import ReachStaticTargetAltitudeTask
+
+    def make(n: int) -> tuple[OfflineEnv, Team, np.ndarray]:
+        team = Team("red", [(c172p(f"red-{i}"), ReachStaticTargetAltitudeTask) for i in range(n)])
+        env = OfflineEnv()
+        env.reset(team, seed=0)
+        return env, team, np.tile([0.0, 0.0, 0.0, 0.75], n)
+
+    one, eight = make(1), make(8)
+
+    def runner(case: tuple[OfflineEnv, Team, np.ndarray]) -> Callable[[int], None]:
+        env, team, action = case
+
+        def run(n: int) -> None:
+            env.reset(team, seed=0)
+            for _ in range(n):
+                info = env.step(action)[-1]
+            # a terminated aircraft is no longer simulated and would flatter the figure
+            assert not any(info["terminated"]), info["reasons"]
+
+        return run
+
+    rates = best_rate({"1": runner(one), "8": runner(eight)}, steps, rounds)
+    per_one, per_eight = rates["1"], rates["8"] * 8
+    return {"one": per_one, "eight": per_eight, "ratio": per_eight / per_one}
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    p.add_argument("--json", type=Path, help="write the rows to this JSON file")
+    p.add_argument("--quick", action="store_true", help="fewer, shorter rounds (a smoke run)")
+    args = p.parse_args(argv)
+    steps, rounds = (200, 2) if args.quick else (900, 7)
+
+    rows = []
+    r = env_vs_raw(steps, rounds)
+    print(f"env.step (c172p, 10 Hz)      {r['env']:9,.0f} steps/s")
+    print(f"raw FGFDMExec, same I/O      {r['raw']:9,.0f} steps/s")
+    print(f"env_step_vs_raw_jsbsim       {r['ratio']:9.3f}   (target >= 0.90)\n")
+    rows.append(
+        {
+            "name": "env_step_vs_raw_jsbsim",
+            "value": r["ratio"],
+            "unit": "ratio",
+            "target": 0.90,
+            "higher_is_better": True,
+        }
+    )
+    r = eight_vs_one(steps // 2, rounds)
+    print(f"1 aircraft                   {r['one']:9,.0f} aircraft-steps/s")
+    print(f"8 aircraft                   {r['eight']:9,.0f} aircraft-steps/s")
+    print(f"per_aircraft_8_vs_1          {r['ratio']:9.3f}   (target >= 0.85)")
+    rows.append(
+        {
+            "name": "per_aircraft_8_vs_1",
+            "value": r["ratio"],
+            "unit": "ratio",
+            "target": 0.85,
+            "higher_is_better": True,
+        }
+    )
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=2))
+        print(f"\nwrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
