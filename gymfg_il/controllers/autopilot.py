@@ -89,6 +89,7 @@ class Autopilot:
         self.speed_pid = PID(*g.speed, out_min=0.0, out_max=1.0)
         self.start: np.ndarray | None = None
         self._last_heading_target: float | None = None
+        self._last_altitude_target: float | None = None
         self.throttle_trim = 0.7
 
     def reset(self, seed: int | None = None) -> None:
@@ -96,6 +97,7 @@ class Autopilot:
             pid.reset()
         self.start = None
         self._last_heading_target = None
+        self._last_altitude_target = None
 
     def set_throttle_trim(self, throttle: float) -> None:
         self.throttle_trim = throttle
@@ -123,7 +125,10 @@ class Autopilot:
             else:
                 alt_target = self._value(obs, t.vertical_source, "altitude_ft")
                 alt_error = alt_target - obs[i["altitude_ft"]]
-                climb_target = g.altitude_to_climb * alt_error
+                # feed-forward: climb at the target's own rate while it moves
+                last, self._last_altitude_target = self._last_altitude_target, alt_target
+                target_rate = 0.0 if last is None else (alt_target - last) / dt
+                climb_target = g.altitude_to_climb * alt_error + target_rate
             climb_target = max(-g.max_descent_fps, min(g.max_climb_fps, climb_target))
             pitch_target = self.climb_pid(climb_target, obs[i["vertical_speed_fps"]], dt)
         pitch_target = max(-g.max_pitch_deg, min(g.max_pitch_deg, pitch_target))

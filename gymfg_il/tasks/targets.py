@@ -181,7 +181,10 @@ class TargetTask(Task):
 
     def task_reward(self, ctx: RewardContext) -> float:
         """closeness(error, reward_scale) - 0.05 * mean |change of the three surfaces|."""
-        err = self.error(ctx.state.values[self._var], ctx.step)
+        target = ctx.target if ctx.target is not None else self.target_value(ctx.step)
+        err = target - ctx.state.values[self._var]
+        if self.family.angular:
+            err = (err + 180.0) % 360.0 - 180.0
         smooth = action_change(ctx.prev_action, ctx.action)
         return math.exp(-abs(err) / self.reward_scale) - SMOOTHNESS_WEIGHT * smooth
 

@@ -27,13 +27,17 @@ def fly(family, model, target, seconds=150, dynamic=False):
     )
     obs, _ = env.reset(seed=0)
     pilot.reset(0)
-    errors, done = [], False
+    errors, actions, done = [], [], False
     while not done:
-        obs, _, terminated, truncated, _ = env.step(pilot.act(obs))
+        action = pilot.act(obs)
+        obs, _, terminated, truncated, _ = env.step(action)
         errors.append(obs[-1])
+        actions.append(action)
         done = terminated or truncated
     env.close()
     assert not terminated
+    # no chatter: the surfaces move smoothly from step to step
+    assert np.abs(np.diff(np.array(actions)[:, :3], axis=0)).mean() < 0.01
     return np.abs(np.array(errors))
 
 
@@ -46,7 +50,7 @@ def test_controller_reaches_and_holds(model, family, target, tolerance):
 
 
 @pytest.mark.parametrize("model", ["c172p", "f15", "A320"])
-@pytest.mark.parametrize(("family", "bound"), [("altitude", 150), ("roll", 8), ("heading", 10)])
+@pytest.mark.parametrize(("family", "bound"), [("altitude", 60), ("roll", 8), ("heading", 10)])
 def test_dynamic_targets_are_tracked_with_bounded_error(model, family, bound):
     errors = fly(family, model, None, seconds=90, dynamic=True)
     assert errors[300:].max() < bound

@@ -1,0 +1,1 @@
+"""Evaluation: fly agents on the same seeded cases, score them, report tables, JSON and plots."""

@@ -1,0 +1,1 @@
+"""Visualization: plots of flown episodes (and, later, the FlightGear bridge)."""
