@@ -67,7 +67,8 @@ def fly_episode(env: AircraftEnv, agent: Agent, seed: int) -> Episode:
     i_err = names.index("altitude_ft_error" if level else f"{variable}_error")
     i_val = names.index(variable)
     targets, values, errors, actions, rewards = [], [], [], [], []
-    terminated, truncated, info = False, False, {}
+    terminated, truncated = False, False
+    info: dict[str, object] = {}
     while not (terminated or truncated):
         action = np.asarray(agent.act(obs), dtype=np.float64)
         obs, reward, terminated, truncated, info = env.step(action)
@@ -89,7 +90,7 @@ def fly_episode(env: AircraftEnv, agent: Agent, seed: int) -> Episode:
         actions=np.array(actions),
         rewards=np.array(rewards),
         terminated=bool(terminated),
-        reason=info.get("reason"),
+        reason=str(info["reason"]) if "reason" in info else None,
     )
 
 
