@@ -114,6 +114,60 @@ def eight_vs_one(steps: int, rounds: int) -> dict[str, float]:
     return {"one": per_one, "eight": per_eight, "ratio": per_eight / per_one}
 
 
+def dataset_build(episodes: int) -> dict[str, float]:
+    """Frames/s of ``build_from_logs`` (reading the MCAP logs included) against LeRobot's
+    per-frame path (``add_frame`` + ``save_episode`` from frames already in memory)."""
+    import os
+    import shutil
+    import tempfile
+
+    os.environ.setdefault("HF_HUB_OFFLINE", "1")
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    from gymfg_il.collectors.autopilot import record_autopilot
+    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.datasets.features import dataset_features
+    from gymfg_il.datasets.from_logs import build_from_logs, episode_columns
+    from gymfg_il.recording.reader import read_log
+
+    tmp = Path(tempfile.mkdtemp(prefix="gymfg-bench-"))
+    try:
+        cfg = CollectConfig(episodes=episodes, out=tmp / "session")
+        result = record_autopilot(cfg)
+        t0 = time.perf_counter()
+        report = build_from_logs([result.log], tmp / "ours")
+        ours = report.frames / (time.perf_counter() - t0)
+
+        log = read_log(result.log)
+        names = log.session["observation_names"]
+        task = log.session["task_description"]
+        t0 = time.perf_counter()
+        ds = LeRobotDataset.create(
+            "gymfg/bench", 10, dataset_features(names), root=tmp / "stock", use_videos=False
+        )
+        frames = 0
+        for ep in log.complete_episodes:
+            cols = episode_columns(ep, "ego")
+            for i in range(len(cols["action"])):
+                ds.add_frame(
+                    {
+                        "observation.state": cols["observation.state"][i].astype(np.float32),
+                        "action": cols["action"][i].astype(np.float32),
+                        "next.reward": np.array([cols["next.reward"][i]], np.float32),
+                        "next.done": np.array([cols["next.done"][i]]),
+                        "intervention": np.array([cols["intervention"][i]]),
+                        "task": task,
+                    }
+                )
+                frames += 1
+            ds.save_episode()
+        ds.finalize()
+        stock = frames / (time.perf_counter() - t0)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return {"ours": ours, "stock": stock, "ratio": ours / stock}
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     p.add_argument("--json", type=Path, help="write the rows to this JSON file")

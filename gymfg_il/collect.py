@@ -1,0 +1,181 @@
+"""``python -m gymfg_il.collect``: record demonstrations as MCAP logs and LeRobot datasets.
+
+    python -m gymfg_il.collect autopilot --aircraft c172p --task altitude --episodes 20 --out DIR
+    python -m gymfg_il.collect collectors/sample.toml        # a recipe
+    python -m gymfg_il.collect recover DIR                   # rebuild DIR/dataset from DIR/logs
+
+A session folder holds ``logs/`` (one MCAP log per session: every step, the write-ahead log)
+and ``dataset/`` (LeRobot v3.0). Collecting into an existing folder appends.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from gymfg_il.datasets.from_logs import BuildReport
+
+EPILOG = __doc__.split("\n\n", 1)[1]
+
+
+def _autopilot_args(p: argparse.ArgumentParser, recipe: bool) -> None:
+    d = None if recipe else argparse.SUPPRESS
+    p.add_argument("--aircraft", default=d, help="JSBSim model (default: c172p)")
+    p.add_argument(
+        "--task",
+        default=d,
+        help="task family: altitude, roll, pitch, heading, airspeed, level (default: altitude)",
+    )
+    p.add_argument(
+        "--dynamic",
+        action="store_const",
+        const=True,
+        default=d,
+        help="moving targets instead of fixed ones",
+    )
+    p.add_argument("--episodes", type=int, default=d, help="episodes to record (default: 10)")
+    p.add_argument(
+        "--episode-time",
+        dest="episode_time_s",
+        type=float,
+        default=d,
+        help="seconds per episode (default: 90)",
+    )
+    p.add_argument(
+        "--agent-hz",
+        type=int,
+        default=d,
+        help="agent rate = dataset fps, a divisor of 120 (default: 10)",
+    )
+    p.add_argument("--seed", type=int, default=d, help="seed of the first episode (default: 0)")
+    p.add_argument(
+        "--noise",
+        type=float,
+        default=d,
+        help="DART noise: std of Gaussian noise on the executed surfaces; the "
+        "dataset keeps the clean label (default: 0)",
+    )
+    p.add_argument(
+        "--out", type=Path, default=d, help="session folder (default: datasets/autopilot)"
+    )
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    p = argparse.ArgumentParser(
+        prog="python -m gymfg_il.collect",
+        description="Record demonstrations: every step to an MCAP log, every completed episode "
+        "to a LeRobot dataset.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    sub = p.add_subparsers(dest="command", metavar="{autopilot,recover,RECIPE.toml}")
+    auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
+    _autopilot_args(auto, recipe=False)
+    rec = sub.add_parser(
+        "recover",
+        help="rebuild DIR/dataset from the logs in DIR/logs "
+        "(after a crash or kill: keeps every completed episode)",
+    )
+    rec.add_argument("dir", type=Path, help="session folder")
+    if argv and argv[0].endswith(".toml"):
+        r = argparse.ArgumentParser(
+            prog="python -m gymfg_il.collect RECIPE.toml",
+            description="Run a collection recipe (collectors/*.toml); options override the recipe.",
+        )
+        r.add_argument("recipe", type=Path)
+        _autopilot_args(r, recipe=True)
+        args = r.parse_args(argv)
+        args.command = "recipe"
+        return args
+    args = p.parse_args(argv)
+    if args.command is None:
+        p.print_help()
+        p.exit(2)
+    return args
+
+
+def _report_build(report: BuildReport, root: Path) -> None:
+    r = report
+    note = ", rebuilt from the logs" if r.rebuilt else ""
+    print(
+        f"dataset {root}: {r.total_episodes} episodes (+{r.added}, {r.frames} frames in "
+        f"{r.seconds:.2f} s{note})"
+    )
+    if r.skipped_incomplete:
+        print(
+            f"left out {r.skipped_incomplete} unfinished episode(s) (the session stopped "
+            "mid-episode)"
+        )
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(list(sys.argv[1:] if argv is None else argv))
+    from gymfg_il.errors import GymFGError
+
+    try:
+        if args.command == "recover":
+            return recover(args.dir)
+        from gymfg_il.collectors.config import CollectConfig
+
+        options = {
+            k: v
+            for k, v in vars(args).items()
+            if k not in ("command", "recipe", "no_progress") and v is not None
+        }
+        cfg = (
+            CollectConfig.from_recipe(args.recipe, **options)
+            if args.command == "recipe"
+            else CollectConfig(**options)
+        )
+        return collect(cfg, progress=not args.no_progress)
+    except GymFGError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+
+
+def collect(cfg: object, progress: bool = True) -> int:
+    from tqdm import tqdm
+
+    from gymfg_il.collectors.autopilot import DATASET, LOGS, record_autopilot
+    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.datasets.from_logs import build_from_logs
+
+    assert isinstance(cfg, CollectConfig)
+    bar = tqdm(
+        total=cfg.episodes, desc="episodes", unit="ep", disable=not progress, file=sys.stderr
+    )
+
+    def tick(i: int, ret: float) -> None:
+        bar.update(1)
+        bar.set_postfix(ret=f"{ret:.1f}")
+
+    result = record_autopilot(cfg, progress=tick)
+    bar.close()
+    print(f"logged {result.episodes} episodes ({result.steps} steps) to {result.log}")
+    report = build_from_logs(sorted((cfg.out / LOGS).glob("*.mcap")), cfg.out / DATASET)
+    _report_build(report, cfg.out / DATASET)
+    return 0
+
+
+def recover(folder: Path) -> int:
+    from gymfg_il.collectors.autopilot import DATASET, LOGS
+    from gymfg_il.datasets.from_logs import build_from_logs
+    from gymfg_il.errors import ConfigError
+
+    logs = sorted((folder / LOGS).glob("*.mcap")) if folder.is_dir() else []
+    if not logs:
+        raise ConfigError(
+            f"{folder} holds no {LOGS}/*.mcap: nothing to recover from (is it a "
+            "collection session folder?)"
+        )
+    report = build_from_logs(logs, folder / DATASET)
+    _report_build(report, folder / DATASET)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,1 @@
+"""Collection sessions: demonstrations flown by the autopilot (and, later, humans)."""

@@ -1,0 +1,95 @@
+"""What a collection session flies and where it writes: one dataclass, from CLI or recipe.
+
+A recipe is a TOML file with a ``[collector]`` table holding these fields, e.g.
+``collectors/sample.toml``; ``python -m gymfg_il.collect collectors/NAME.toml`` runs it.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.sim.timing import substeps
+from gymfg_il.tasks.library import task_class
+
+
+@dataclass
+class CollectConfig:
+    """A collection session.
+
+    Attributes:
+        kind: who flies: ``autopilot`` (the task's PID controller).
+        aircraft: JSBSim model.
+        task: task family (altitude, roll, pitch, heading, airspeed, level).
+        dynamic: moving targets.
+        episodes: episodes to record.
+        episode_time_s: seconds per episode.
+        agent_hz: agent rate = dataset fps; divides 120.
+        seed: seed of the first episode (episode i uses seed + i).
+        noise: DART-style noise: std of Gaussian noise added to the executed surfaces (the
+            dataset keeps the demonstrator's clean action as the label); 0 = none.
+        out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
+        task_kwargs: arguments of the task class (e.g. ``target_range``).
+    """
+
+    kind: str = "autopilot"
+    aircraft: str = "c172p"
+    task: str = "altitude"
+    dynamic: bool = False
+    episodes: int = 10
+    episode_time_s: float = 90.0
+    agent_hz: int = 10
+    seed: int = 0
+    noise: float = 0.0
+    out: Path = Path("datasets/autopilot")
+    task_kwargs: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.out = Path(self.out)
+        problems = []
+        if self.kind != "autopilot":
+            problems.append(f"kind={self.kind!r}: only 'autopilot' collects without a person")
+        if self.task in ("dummy",):
+            problems.append("task 'dummy' has no controller to demonstrate it")
+        else:
+            try:
+                task_class(self.task, self.dynamic)
+            except ConfigError as err:
+                problems.append(str(err))
+        if not isinstance(self.episodes, int) or self.episodes < 1:
+            problems.append(f"episodes={self.episodes!r} must be an integer >= 1")
+        if not (isinstance(self.episode_time_s, (int, float)) and self.episode_time_s > 0):
+            problems.append(f"episode_time_s={self.episode_time_s!r} must be > 0")
+        try:
+            substeps(120, self.agent_hz)
+        except ConfigError as err:
+            problems.append(str(err))
+        if not (
+            isinstance(self.noise, (int, float)) and math.isfinite(self.noise) and self.noise >= 0
+        ):
+            problems.append(f"noise={self.noise!r} must be a number >= 0")
+        if problems:
+            raise ConfigError(join_problems("collection config", problems))
+
+    @classmethod
+    def from_recipe(cls, path: Path, **overrides: Any) -> CollectConfig:
+        """Read ``[collector]`` from a TOML recipe; ``overrides`` win over the file."""
+        path = Path(path)
+        if not path.is_file():
+            raise ConfigError(f"no recipe at {path}; recipes live in collectors/*.toml")
+        try:
+            data = tomllib.loads(path.read_text())
+        except tomllib.TOMLDecodeError as err:
+            raise ConfigError(f"{path} is not valid TOML: {err}") from None
+        table = data.get("collector")
+        if not isinstance(table, dict):
+            raise ConfigError(f"{path} has no [collector] table")
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(table) - known)
+        if unknown:
+            raise ConfigError(f"{path}: unknown keys {unknown}; known: {sorted(known)}")
+        return cls(**{**table, **{k: v for k, v in overrides.items() if v is not None}})

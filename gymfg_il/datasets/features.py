@@ -1,0 +1,62 @@
+"""The dataset's features, derived from the task's observation names and the action contract.
+
+| feature | dtype | shape | meaning |
+| --- | --- | --- | --- |
+| observation.state | float32 | (n,) | the task's observation, ``names`` = its variable names |
+| action | float32 | (4,) | the demonstrator's [aileron, elevator, rudder, throttle] |
+| next.reward | float32 | (1,) | reward of the step |
+| next.done | bool | (1,) | the episode ended with this step |
+| intervention | bool | (1,) | a human flew this step (human takeover / DAgger) |
+
+Plus LeRobot's own ``timestamp``, ``frame_index``, ``episode_index``, ``index``, ``task_index``
+and a ``task`` string per frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from gymfg_il.errors import ConfigError
+from gymfg_il.sim.properties import ACTION_NAMES
+
+OUR_KEYS = ("observation.state", "action", "next.reward", "next.done", "intervention")
+
+
+def dataset_features(observation_names: Sequence[str]) -> dict[str, dict[str, Any]]:
+    return {
+        "observation.state": {
+            "dtype": "float32",
+            "shape": (len(observation_names),),
+            "names": list(observation_names),
+        },
+        "action": {"dtype": "float32", "shape": (4,), "names": list(ACTION_NAMES)},
+        "next.reward": {"dtype": "float32", "shape": (1,), "names": None},
+        "next.done": {"dtype": "bool", "shape": (1,), "names": None},
+        "intervention": {"dtype": "bool", "shape": (1,), "names": None},
+    }
+
+
+def check_compatible(
+    existing: dict[str, dict[str, Any]], wanted: dict[str, dict[str, Any]], where: str
+) -> None:
+    """Appending needs identical features; say exactly what differs."""
+    problems = []
+    for key in OUR_KEYS:
+        have, want = existing.get(key), wanted[key]
+        if have is None:
+            problems.append(f"{key} is missing from the existing dataset")
+            continue
+        for attr in ("dtype", "shape", "names"):
+            a, b = have.get(attr), want.get(attr)
+            if attr == "shape":
+                a, b = tuple(a or ()), tuple(b or ())
+            if a != b:
+                problems.append(f"{key}.{attr}: existing {a!r}, new {b!r}")
+    if problems:
+        raise ConfigError(
+            f"cannot append to the dataset at {where}: its features differ ("
+            + "; ".join(problems)
+            + "). Collect into another --out folder, or use the task and aircraft it was "
+            "made with"
+        )

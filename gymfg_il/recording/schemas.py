@@ -1,0 +1,105 @@
+"""JSON schemas of the MCAP channels, derived from the state-variable catalogue.
+
+Channels (Foxglove conventions: JSON messages with a ``jsonschema`` schema):
+
+- ``/gymfg/episode`` (``gymfg.EpisodeEvent``): start (seed, task, target, initial state),
+  end (outcome), discard.
+- ``/gymfg/<callsign>/step`` (``gymfg.Step``): every agent step: observation, action, label
+  (the demonstrator's action), reward, flags.
+- ``/gymfg/<callsign>/state`` (``gymfg.State``): the full state after every step.
+- ``/gymfg/<callsign>/location`` (``foxglove.LocationFix``): position for Foxglove's map.
+
+Session metadata (aircraft, task, rates, package versions) is an MCAP metadata record named
+``gymfg.session``.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+
+from gymfg_il.sim.properties import ACTION_NAMES, CATALOGUE
+
+SCHEMA_VERSION = 1
+
+_ACTION = {
+    "type": "object",
+    "properties": {n: {"type": "number"} for n in ACTION_NAMES},
+    "required": list(ACTION_NAMES),
+}
+
+STEP = {
+    "title": "gymfg.Step",
+    "type": "object",
+    "properties": {
+        "episode": {"type": "integer", "description": "episode number in this log"},
+        "step": {"type": "integer", "description": "agent steps since the reset (1 = first)"},
+        "time_s": {"type": "number", "description": "simulated seconds since the reset"},
+        "observation": {
+            "type": "array",
+            "items": {"type": "number"},
+            "description": "the task observation the action was chosen from",
+        },
+        "action": {**_ACTION, "description": "the action applied (after clipping)"},
+        "label": {**_ACTION, "description": "the demonstrator's action (before any noise)"},
+        "reward": {"type": "number"},
+        "terminated": {"type": "boolean"},
+        "truncated": {"type": "boolean"},
+        "intervention": {"type": "boolean", "description": "a human flew this step"},
+    },
+    "required": ["episode", "step", "observation", "action", "label", "reward"],
+}
+
+STATE = {
+    "title": "gymfg.State",
+    "type": "object",
+    "description": "the aircraft's full state after a step (the property catalogue)",
+    "properties": {
+        "episode": {"type": "integer"},
+        "step": {"type": "integer"},
+        **{
+            v.name: {"type": "number", "description": f"{v.description} [{v.unit}] ({v.prop})"}
+            for v in CATALOGUE
+        },
+    },
+}
+
+EPISODE_EVENT = {
+    "title": "gymfg.EpisodeEvent",
+    "type": "object",
+    "properties": {
+        "event": {"type": "string", "enum": ["start", "end", "discard"]},
+        "episode": {"type": "integer"},
+        "seed": {"type": "integer"},
+        "task": {"type": "object"},
+        "target": {"type": ["number", "null"]},
+        "initial_state": {"type": "object"},
+        "outcome": {"type": "string"},
+        "steps": {"type": "integer"},
+        "source": {"type": "string"},
+        "interventions": {"type": "integer"},
+    },
+    "required": ["event", "episode"],
+}
+
+# Foxglove's built-in schema is matched by its exact name.
+LOCATION_FIX = {
+    "title": "foxglove.LocationFix",
+    "type": "object",
+    "properties": {
+        "timestamp": {
+            "type": "object",
+            "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}},
+        },
+        "frame_id": {"type": "string"},
+        "latitude": {"type": "number"},
+        "longitude": {"type": "number"},
+        "altitude": {"type": "number", "description": "meters above the WGS84 ellipsoid"},
+        "position_covariance": {"type": "array", "items": {"type": "number"}},
+        "position_covariance_type": {"type": "integer"},
+    },
+}
+
+
+def encoded(schema: Mapping[str, object]) -> bytes:
+    return json.dumps(schema).encode()
