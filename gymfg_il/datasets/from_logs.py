@@ -109,6 +109,8 @@ def build_from_logs(
 
 
 def _build(log_paths: Sequence[Path], root: Path, repo_id: str | None) -> BuildReport:
+    import lerobot.datasets.dataset_metadata  # noqa: F401  (its import is not build time)
+
     started = time.perf_counter()
     logs: list[Log] = [read_log(p) for p in sorted(log_paths)]
     if not logs:

@@ -1,0 +1,121 @@
+"""The collect command, driven as a user would: real processes, real files, real kills."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from gymfg_il import collect
+from gymfg_il.collectors.config import CollectConfig
+from gymfg_il.errors import ConfigError
+
+ENV = {**os.environ, "HF_HUB_OFFLINE": "1", "PYTHONUNBUFFERED": "1"}
+
+
+def test_recipe_runs_and_options_override(tmp_path, capsys):
+    recipe = tmp_path / "r.toml"
+    recipe.write_text(
+        '[collector]\ntask = "pitch"\nepisodes = 5\nepisode_time_s = 10.0\n'
+        f'out = "{tmp_path / "from-recipe"}"\n'
+    )
+    assert collect.main([str(recipe), "--episodes", "2", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "dataset" in out and "2 episodes" in out
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    ds = LeRobotDataset("x/y", root=tmp_path / "from-recipe" / "dataset")
+    assert ds.num_episodes == 2 and ds.fps == 10
+
+
+def test_bundled_recipes_are_valid():
+    from pathlib import Path
+
+    recipes = sorted(Path(__file__).resolve().parents[2].glob("collectors/*.toml"))
+    assert recipes
+    for path in recipes:
+        assert CollectConfig.from_recipe(path).episodes >= 1
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("[collector]\ntask = 'altitud'\n", "unknown task"),
+        ("[collector]\nagent_hz = 7\n", "agent_hz=7"),
+        ("[collector]\nepisodes = 0\nnoise = -1\n", "2 problems"),
+        ("[collector]\ncolour = 'red'\n", "unknown keys"),
+        ("collector = 3\n", "no \\[collector\\] table"),
+        ("[collector\n", "not valid TOML"),
+    ],
+)
+def test_bad_recipes_say_what_is_wrong(tmp_path, text, match):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=match):
+        CollectConfig.from_recipe(path)
+
+
+def test_recover_of_missing_or_foreign_folders(tmp_path, capsys):
+    assert collect.main(["recover", str(tmp_path / "nope")]) == 2
+    (tmp_path / "foreign").mkdir()
+    (tmp_path / "foreign" / "notes.txt").write_text("mine")
+    assert collect.main(["recover", str(tmp_path / "foreign")]) == 2
+    err = capsys.readouterr().err
+    assert "nothing to recover" in err
+    assert (
+        collect.main(
+            ["autopilot", "--out", str(tmp_path / "foreign"), "--episodes", "1", "--no-progress"]
+        )
+        == 2
+    )
+    assert "not a collection session" in capsys.readouterr().err
+    assert sorted(p.name for p in (tmp_path / "foreign").iterdir()) == ["notes.txt"]
+
+
+def test_corrupt_log_is_a_clear_error(tmp_path, capsys):
+    (tmp_path / "logs").mkdir()
+    (tmp_path / "logs" / "session-x.mcap").write_bytes(os.urandom(4000))
+    assert collect.main(["recover", str(tmp_path)]) == 2
+    assert "not a readable GymFG trajectory log" in capsys.readouterr().err
+
+
+def test_sigkill_at_random_moments_loses_no_completed_episode(tmp_path):
+    """Kill real collector processes at random moments; recover must keep every episode the
+    collector reported as saved (it reports only after the episode is durable)."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    rng = np.random.default_rng(12345)
+    out = tmp_path / "session"
+    reported_total = 0
+    for trial in range(3):
+        cmd = [
+            sys.executable,
+            "-m",
+            "gymfg_il.collect",
+            "autopilot",
+            "--out",
+            str(out),
+            "--episodes",
+            "40",
+            "--episode-time",
+            "10",
+            "--seed",
+            str(100 * trial),
+            "--no-progress",
+        ]
+        with open(tmp_path / f"stdout{trial}", "w") as stdout:
+            proc = subprocess.Popen(cmd, stdout=stdout, stderr=subprocess.DEVNULL, env=ENV)
+            time.sleep(float(rng.uniform(1.5, 4.0)))
+            proc.send_signal(signal.SIGKILL)
+            proc.wait()
+        reported = (tmp_path / f"stdout{trial}").read_text().count("saved")
+        reported_total += reported
+        assert collect.main(["recover", str(out)]) == 0
+        ds = LeRobotDataset("x/y", root=out / "dataset")
+        assert ds.num_episodes >= reported_total  # nothing reported as saved was lost
+        assert len(ds) == ds.num_episodes * 100
+    assert reported_total > 0
+    assert not list(tmp_path.glob("session/dataset.*"))  # no half-built copies left behind

@@ -1,0 +1,98 @@
+import hashlib
+import os
+
+import numpy as np
+import pytest
+
+from gymfg_il.collectors.autopilot import record_autopilot
+from gymfg_il.collectors.config import CollectConfig
+from gymfg_il.datasets.from_logs import build_from_logs
+from gymfg_il.errors import ConfigError
+from gymfg_il.recording.reader import read_log
+
+os.environ["HF_HUB_OFFLINE"] = "1"
+
+
+def tree_digest(root):
+    h = hashlib.sha256()
+    for dirpath, _, files in sorted(os.walk(root)):
+        for name in sorted(files):
+            path = os.path.join(dirpath, name)
+            h.update(path.encode())
+            with open(path, "rb") as f:
+                h.update(f.read())
+    return h.hexdigest()
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    out = tmp_path_factory.mktemp("collect")
+    cfg = CollectConfig(task="altitude", episodes=3, episode_time_s=15, out=out)
+    result = record_autopilot(cfg)
+    report = build_from_logs([result.log], out / "dataset")
+    return out, result, report
+
+
+def test_dataset_opens_with_stock_lerobot_and_equals_the_log(built):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    out, result, report = built
+    assert report.added == 3 and report.frames == 450
+    ds = LeRobotDataset("anything/name", root=out / "dataset")
+    assert ds.num_episodes == 3 and len(ds) == 450 and ds.fps == 10
+    log = read_log(result.log)
+    names = log.session["observation_names"]
+    assert ds.meta.features["observation.state"]["names"] == names
+    assert ds.meta.features["action"]["names"] == ["aileron", "elevator", "rudder", "throttle"]
+    for k, ep in enumerate(log.complete_episodes):
+        steps = ep.steps["ego"]
+        start = k * 150
+        frames = [ds[start + i] for i in (0, 77, 149)]
+        for frame, i in zip(frames, (0, 77, 149), strict=True):
+            assert np.array_equal(
+                frame["observation.state"].numpy(), steps.observation[i].astype(np.float32)
+            )
+            assert np.array_equal(frame["action"].numpy(), steps.label[i].astype(np.float32))
+            assert frame["next.reward"].item() == pytest.approx(steps.reward[i], rel=1e-6)
+            assert bool(frame["next.done"]) == (i == 149)
+            assert frame["task"].startswith("Climb or descend")
+        meta = ds.meta.episodes[k]
+        assert meta["gymfg/seed"] == k and meta["gymfg/source"] == "autopilot"
+        assert meta["gymfg/aircraft"] == "c172p" and meta["gymfg/interventions"] == 0
+        assert meta["gymfg/target"] == pytest.approx(ep.start["target"])
+
+
+def test_rebuilding_adds_nothing_twice_and_keeps_data(built):
+    out, result, _ = built
+    before = tree_digest(out / "dataset")
+    again = build_from_logs([result.log], out / "dataset")
+    assert again.added == 0 and again.total_episodes == 3
+    assert tree_digest(out / "dataset") != "" and before  # still readable below
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    assert LeRobotDataset("x/y", root=out / "dataset").num_episodes == 3
+
+
+def test_appending_mismatched_features_is_refused_and_touches_nothing(built, tmp_path):
+    out, _, _ = built
+    before = tree_digest(out / "dataset")
+    other = CollectConfig(task="roll", episodes=1, episode_time_s=5, out=tmp_path / "roll")
+    roll_log = record_autopilot(other).log
+    with pytest.raises(ConfigError, match="observation"):
+        build_from_logs([roll_log], out / "dataset")
+    with pytest.raises(ConfigError, match="features differ"):
+        record_autopilot(CollectConfig(task="roll", episodes=1, episode_time_s=5, out=out))
+    assert tree_digest(out / "dataset") == before
+    assert len(list((out / "logs").glob("*.mcap"))) == 1  # nothing was flown or logged
+
+
+def test_a_broken_dataset_is_set_aside_and_rebuilt(built, tmp_path):
+    out, result, _ = built
+    import shutil
+
+    root = tmp_path / "dataset"
+    shutil.copytree(out / "dataset", root)
+    (root / "meta" / "info.json").write_text("{ broken")
+    report = build_from_logs([result.log], root)
+    assert report.rebuilt and report.total_episodes == 3
+    assert list(tmp_path.glob("dataset.broken-*"))
