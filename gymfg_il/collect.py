@@ -4,6 +4,7 @@
     python -m gymfg_il.collect collectors/sample.toml        # a recipe
     python -m gymfg_il.collect recover DIR                   # rebuild DIR/dataset from DIR/logs
     python -m gymfg_il.collect replay DIR                    # re-fly logged episodes, compare
+    python -m gymfg_il.collect dagger --policy P --out DIR   # DAgger with the controller
 
 A session folder holds ``logs/`` (one MCAP log per session: every step, the write-ahead log)
 and ``dataset/`` (LeRobot v3.0). Collecting into an existing folder appends.
@@ -62,6 +63,13 @@ def _autopilot_args(p: argparse.ArgumentParser, recipe: bool) -> None:
     p.add_argument(
         "--out", type=Path, default=d, help="session folder (default: datasets/autopilot)"
     )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help="worker processes flying episodes; the log and dataset are identical "
+        "to one worker's (default: 1)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -73,7 +81,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    sub = p.add_subparsers(dest="command", metavar="{autopilot,recover,replay,RECIPE.toml}")
+    sub = p.add_subparsers(dest="command", metavar="{autopilot,dagger,recover,replay,RECIPE.toml}")
     auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
     _autopilot_args(auto, recipe=False)
     rec = sub.add_parser(
@@ -82,6 +90,29 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         "(after a crash or kill: keeps every completed episode)",
     )
     rec.add_argument("dir", type=Path, help="session folder")
+    dag = sub.add_parser(
+        "dagger",
+        help="the policy flies, the controller labels what it "
+        "visits, the data is aggregated and the policy retrained",
+    )
+    dag.add_argument("--policy", type=Path, required=True, help="checkpoint to start from")
+    dag.add_argument(
+        "--expert",
+        default="controller",
+        choices=["controller"],
+        help="who labels the visited states (default: the task's controller)",
+    )
+    dag.add_argument("--iterations", type=int, default=3, help="rounds (default: 3)")
+    dag.add_argument("--episodes", type=int, default=10, help="episodes per round (default: 10)")
+    dag.add_argument("--seed", type=int, default=2000, help="first seed (default: 2000)")
+    dag.add_argument("--epochs", type=int, help="training epochs per round (default: the policy's)")
+    dag.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="session folder: logs/, dataset/ (the aggregate), policy-<k>/",
+    )
+    dag.add_argument("--workers", type=int, default=1, help="worker processes (default: 1)")
     rep = sub.add_parser(
         "replay",
         help="re-fly logged episodes through JSBSim from their seeds "
@@ -129,25 +160,27 @@ def main(argv: list[str] | None = None) -> int:
             return recover(args.dir)
         if args.command == "replay":
             return replay(args.log, args.episode)
+        if args.command == "dagger":
+            return dagger(args)
         from gymfg_il.collectors.config import CollectConfig
 
         options = {
             k: v
             for k, v in vars(args).items()
-            if k not in ("command", "recipe", "no_progress") and v is not None
+            if k not in ("command", "recipe", "no_progress", "workers") and v is not None
         }
         cfg = (
             CollectConfig.from_recipe(args.recipe, **options)
             if args.command == "recipe"
             else CollectConfig(**options)
         )
-        return collect(cfg, progress=not args.no_progress)
+        return collect(cfg, progress=not args.no_progress, workers=args.workers)
     except GymFGError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
 
 
-def collect(cfg: object, progress: bool = True) -> int:
+def collect(cfg: object, progress: bool = True, workers: int = 1) -> int:
     from tqdm import tqdm
 
     from gymfg_il.collectors.autopilot import DATASET, LOGS, record_autopilot
@@ -165,11 +198,40 @@ def collect(cfg: object, progress: bool = True) -> int:
         if not progress:  # a line per durable episode, for logs and supervising scripts
             print(f"episode {i} saved (return {ret:.1f})", flush=True)
 
-    result = record_autopilot(cfg, progress=tick)
+    result = record_autopilot(cfg, workers=workers, progress=tick)
     bar.close()
-    print(f"logged {result.episodes} episodes ({result.steps} steps) to {result.log}")
+    print(f"logged {len(result.episodes)} episodes ({result.steps} steps) to {result.log}")
     report = build_from_logs(sorted((cfg.out / LOGS).glob("*.mcap")), cfg.out / DATASET)
     _report_build(report, cfg.out / DATASET)
+    return 0
+
+
+def dagger(args: argparse.Namespace) -> int:
+    from gymfg_il.collectors.dagger import DaggerIteration, run_dagger
+
+    def report(step: DaggerIteration) -> None:
+        print(
+            f"iteration {step.iteration}: policy return {step.policy_return:.1f} over "
+            f"{step.episodes} episodes; dataset {step.dataset_episodes} episodes; retrained "
+            f"-> {step.policy} (validation loss {step.val_loss:.4f})",
+            flush=True,
+        )
+
+    overrides = {"epochs": args.epochs} if args.epochs else {}
+    history = run_dagger(
+        args.policy,
+        args.out,
+        args.iterations,
+        args.episodes,
+        args.seed,
+        args.workers,
+        overrides,
+        report,
+    )
+    print(
+        f"final policy: {history[-1].policy} (evaluate it: python -m gymfg_il.eval "
+        f"--policy {history[-1].policy})"
+    )
     return 0
 
 

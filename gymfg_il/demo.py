@@ -1,91 +1,150 @@
-"""``python -m gymfg_il.demo``: fly the default task with its controller and print a table.
+"""``python -m gymfg_il.demo``: the whole imitation-learning loop on the bundled default.
 
-The quick start's main job until the learning loop lands: a c172p flies the static altitude
-task under its PID autopilot on a few seeded targets.
+1. demonstrations: the bundled sample dataset (autopilot, altitude task, c172p), collected
+   again by its recipe if it is missing;
+2. ``train bc``: an MLP policy on it;
+3. ``eval``: the policy against the controller on held-out seeds (the demonstrations used
+   seeds from 1000; evaluation uses 0..N-1);
+4. a report (table, JSON, Figure-1 plots, loss curve) written under ``runs/`` and its path
+   printed.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import shutil
+import sys
 import time
+from pathlib import Path
 
-import numpy as np
-
-from gymfg_il.controllers.autopilot import controller_for
-from gymfg_il.envs.single import AircraftEnv
-from gymfg_il.tasks.library import TASK_FAMILIES
+RECIPE = Path("collectors/sample.toml")
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(
         prog="python -m gymfg_il.demo",
-        description="Fly a GymFG task with its physics-based controller on seeded episodes "
-        "and print one row per episode (target, final value, error, return, outcome).",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
-        "--task",
-        default="altitude",
-        choices=sorted(TASK_FAMILIES),
-        help="task family (default: altitude)",
+        "--dataset",
+        type=Path,
+        default=Path("datasets/sample-altitude-c172p/dataset"),
+        help="demonstrations to learn from (default: the bundled sample)",
     )
-    p.add_argument("--aircraft", default="c172p", help="JSBSim model: c172p, f15, A320, ...")
-    p.add_argument("--dynamic", action="store_true", help="moving targets instead of fixed ones")
-    p.add_argument("--episodes", type=int, default=3, help="episodes to fly (default: 3)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the first episode (default: 0)")
-    p.add_argument("--episode-time", type=float, default=90.0, help="seconds per episode")
+    p.add_argument("--epochs", type=int, default=30, help="training epochs (default: 30)")
+    p.add_argument(
+        "--episodes", type=int, default=10, help="held-out evaluation episodes (default: 10)"
+    )
+    p.add_argument(
+        "--workers", type=int, default=2, help="evaluation worker processes (default: 2)"
+    )
+    p.add_argument(
+        "--runs",
+        type=Path,
+        default=Path("runs"),
+        help="where the report folder goes (default: runs/)",
+    )
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
     return p.parse_args(argv)
 
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
-    env = AircraftEnv(
-        args.task, args.aircraft, dynamic=args.dynamic, episode_time_s=args.episode_time
-    )
-    pilot = controller_for(
-        env.task, env.aircraft.model, env.dt, env.aircraft.profile.cruise_throttle
-    )
-    names = env.observation_names
-    var = names[-2].removesuffix("_target") if names[-2].endswith("_target") else None
-    print(
-        f"{args.task} task, {env.aircraft.model}, {args.episodes} episodes of "
-        f"{args.episode_time:g} s at {env.world.config.agent_hz} Hz, PID autopilot\n"
-    )
-    header = (
-        f"{'episode':>7} {'seed':>5} {'target':>10} {'final':>10} {'|error|':>8} "
-        f"{'return':>8} {'outcome':>10}"
-    )
-    print(header)
-    print("-" * len(header))
+    from gymfg_il import collect, train
+    from gymfg_il import eval as evaluate
+
     started = time.perf_counter()
-    steps = 0
-    for ep in range(args.episodes):
-        seed = args.seed + ep
-        obs, _info = env.reset(seed=seed)
-        pilot.reset(seed)
-        total, done = 0.0, False
-        while not done:
-            obs, reward, terminated, truncated, step_info = env.step(pilot.act(obs))
-            total += reward
-            steps += 1
-            done = terminated or truncated
-        outcome = step_info.get("reason", "crash") if terminated else "time limit"
-        if var is not None:
-            target, error = float(obs[-2]), float(obs[-1])
-            final = target - error
-            print(
-                f"{ep:>7} {seed:>5} {target:>10.1f} {final:>10.1f} {abs(error):>8.2f} "
-                f"{total:>8.1f} {outcome:>10}"
-            )
-        else:
-            print(f"{ep:>7} {seed:>5} {'-':>10} {'-':>10} {'-':>8} {total:>8.1f} {outcome:>10}")
-    elapsed = time.perf_counter() - started
-    print(
-        f"\n{steps} steps in {elapsed:.1f} s ({steps / elapsed:,.0f} steps/s, "
-        f"{steps * env.dt / elapsed:,.0f}x real time)"
-    )
-    env.close()
-    return 0 if np.isfinite(total) else 1
+    quiet = ["--no-progress"] if args.no_progress else []
+    run = args.runs / time.strftime("%Y%m%d-%H%M%S")
+    run.mkdir(parents=True, exist_ok=True)
+    if not (args.dataset / "meta" / "info.json").is_file():
+        print(f"[1/3] {args.dataset} is missing: collecting it with {RECIPE}", flush=True)
+        out = args.dataset.parent
+        if (
+            collect.main([str(RECIPE), "--out", str(out), "--workers", str(args.workers), *quiet])
+            != 0
+        ):
+            return 1
+    else:
+        print(f"[1/3] demonstrations: {args.dataset}", flush=True)
+    policy = run / "policy"
+    print(f"[2/3] behaviour cloning -> {policy}", flush=True)
+    if (
+        train.main(
+            [
+                "bc",
+                "--dataset",
+                str(args.dataset),
+                "--out",
+                str(policy),
+                "--epochs",
+                str(args.epochs),
+                *quiet,
+            ]
+        )
+        != 0
+    ):
+        return 1
+    print(f"[3/3] evaluating against the controller on {args.episodes} held-out seeds", flush=True)
+    if (
+        evaluate.main(
+            [
+                "--policy",
+                str(policy),
+                "--episodes",
+                str(args.episodes),
+                "--workers",
+                str(args.workers),
+                "--json",
+                str(run / "eval.json"),
+                "--plots",
+                str(run / "plots"),
+                *quiet,
+            ]
+        )
+        != 0
+    ):
+        return 1
+    write_report(run, policy, time.perf_counter() - started)
+    print(f"\nreport: {run / 'report.md'}  ({time.perf_counter() - started:.0f} s in all)")
+    return 0
+
+
+def write_report(run: Path, policy: Path, seconds: float) -> None:
+    from gymfg_il.evaluation.report import table
+
+    rows = json.loads((run / "eval.json").read_text())["rows"]
+    meta = json.loads((policy / "config.json").read_text())
+    shutil.copy(policy / "loss.png", run / "loss.png")
+    plots = sorted(p.relative_to(run) for p in (run / "plots").glob("*.png"))
+    lines = [
+        f"# GymFG-IL run {run.name}",
+        "",
+        f"Behaviour cloning ({meta['type']}) on `{meta['dataset']}` "
+        f"({meta['train']['frames']} training frames, {meta['train']['epochs']} epochs), "
+        f"evaluated on {rows[0]['episodes']} held-out seeds of the {rows[0]['task']} task on "
+        f"{rows[0]['aircraft']}.",
+        "",
+        "```",
+        table(rows),
+        "```",
+        "",
+        *[
+            f"- {r['agent']} / controller: return {r['return_ratio']:.1%}, success "
+            f"{r['success_ratio']:.1%}"
+            for r in rows[1:]
+        ],
+        "",
+        "![loss](loss.png)",
+        "",
+        *[f"![{p.stem}]({p})" for p in plots],
+        "",
+        f"Made by `python -m gymfg_il.demo` in {seconds:.0f} s.",
+    ]
+    (run / "report.md").write_text("\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.exit(main())

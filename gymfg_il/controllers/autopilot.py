@@ -99,6 +99,13 @@ class Autopilot:
         self._last_heading_target = None
         self._last_altitude_target = None
 
+    def track(self, applied: np.ndarray) -> None:
+        """Follow an action someone else applied (see ``PID.track``): the surface loops'
+        integrals are set so this controller would have output it."""
+        self.roll_pid.track(float(applied[0]))
+        self.pitch_pid.track(-float(applied[1]))
+        self.speed_pid.track(float(applied[3]))
+
     def set_throttle_trim(self, throttle: float) -> None:
         self.throttle_trim = throttle
 

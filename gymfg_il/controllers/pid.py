@@ -30,6 +30,7 @@ class PID:
     bias: float = 0.0
     integral: float = field(default=0.0, init=False)
     _last: float | None = field(default=None, init=False, repr=False)
+    _inputs: tuple[float, float] | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         values = (self.kp, self.ki, self.kd, self.out_min, self.out_max, self.bias)
@@ -41,6 +42,21 @@ class PID:
     def reset(self) -> None:
         self.integral = 0.0
         self._last = None
+        self._inputs = None
+
+    def track(self, applied: float) -> None:
+        """Back-calculate the integral so the last update would have output ``applied``.
+
+        For when someone else drives the actuator (a policy under DAgger, a human who took
+        over): the integral follows what was really applied instead of winding up, and
+        handing control back is bumpless.
+        """
+        if not self.ki or self._inputs is None:
+            return
+        error, rate = self._inputs
+        self.integral = (applied - self.bias - self.kp * error + self.kd * rate) / self.ki
+        limit = (self.out_max - self.out_min) / abs(self.ki)
+        self.integral = max(-limit, min(limit, self.integral))
 
     def __call__(
         self, setpoint: float, measurement: float, dt: float, rate: float | None = None
@@ -53,6 +69,7 @@ class PID:
         if rate is None:
             rate = 0.0 if self._last is None else (measurement - self._last) / dt
         self._last = measurement
+        self._inputs = (error, rate)
         unclamped = self.bias + self.kp * error + self.ki * self.integral - self.kd * rate
         pushing_up = unclamped >= self.out_max and error > 0
         pushing_down = unclamped <= self.out_min and error < 0

@@ -64,6 +64,7 @@ def episode_metadata(
         "seed": int(start.get("seed", -1)),
         "source": str(start.get("source", session.get("source", ""))),
         "interventions": int(episode.steps[callsign].intervention.sum()),
+        "iteration": int(start.get("iteration", 0)),
         "outcome": str(end.get("outcome", "")),
         "log": log_file.name,
         "log_episode": int(episode.index),

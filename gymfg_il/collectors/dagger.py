@@ -1,0 +1,87 @@
+"""DAgger: the policy flies, the expert (the task's controller) labels every state the policy
+visits, the labelled episodes join the dataset (source ``dagger`` and the iteration are
+recorded per episode), and the policy is trained again on the aggregate."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any
+
+from gymfg_il.collectors.session import DATASET, LOGS, record_session
+from gymfg_il.errors import ConfigError
+from gymfg_il.parallel import AgentSpec, EnvSpec
+
+
+@dataclass
+class DaggerIteration:
+    iteration: int
+    policy_return: float  # mean return of the policy while it collected
+    episodes: int
+    dataset_episodes: int
+    policy: Path
+    val_loss: float
+
+
+def run_dagger(
+    policy: Path,
+    out: Path,
+    iterations: int = 3,
+    episodes: int = 10,
+    seed: int = 2000,
+    workers: int = 1,
+    train_overrides: dict[str, Any] | None = None,
+    on_iteration: Callable[[DaggerIteration], None] | None = None,
+) -> list[DaggerIteration]:
+    """``iterations`` rounds of fly / label / aggregate / retrain, starting from ``policy``."""
+    from gymfg_il.datasets.from_logs import build_from_logs
+    from gymfg_il.learning.bc import TrainConfig, train_bc
+
+    if iterations < 1 or episodes < 1:
+        raise ConfigError("iterations and episodes must be >= 1")
+    meta = AgentSpec.policy(policy).meta()
+    if not meta.get("task") or not meta.get("aircraft"):
+        raise ConfigError(f"{policy} does not record its task and aircraft; DAgger needs them")
+    spec = EnvSpec(meta["task"], meta["aircraft"], bool(meta.get("dynamic")), int(meta["fps"]))
+    root = out / DATASET
+    base = Path(meta.get("dataset", ""))
+    if not root.exists():
+        if not (base / "meta" / "info.json").is_file():
+            raise ConfigError(f"the policy's dataset {base} is gone; DAgger aggregates onto it")
+        out.mkdir(parents=True, exist_ok=True)
+        shutil.copytree(base, root)
+    known = {f.name for f in fields(TrainConfig)}
+    train_args = {k: v for k, v in meta.get("train", {}).items() if k in known}
+    train_args.update(train_overrides or {})
+    current = Path(policy)
+    history = []
+    for it in range(1, iterations + 1):
+        seeds = range(seed + (it - 1) * episodes, seed + it * episodes)
+        session = record_session(
+            spec,
+            AgentSpec.policy(current),
+            AgentSpec.controller(),
+            seeds,
+            out,
+            "dagger",
+            workers=workers,
+            iteration=it,
+        )
+        report = build_from_logs(sorted((out / LOGS).glob("*.mcap")), root)
+        cfg = TrainConfig(**{**train_args, "dataset": root, "out": out / f"policy-{it}"})
+        result = train_bc(cfg)
+        current = result.out
+        step = DaggerIteration(
+            it,
+            sum(session.returns) / len(session.returns),
+            len(session.episodes),
+            report.total_episodes,
+            current,
+            result.val_loss[-1],
+        )
+        history.append(step)
+        if on_iteration is not None:
+            on_iteration(step)
+    return history

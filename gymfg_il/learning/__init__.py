@@ -1,0 +1,1 @@
+"""Learning from demonstrations: in-memory data pipeline, behaviour cloning, DAgger."""

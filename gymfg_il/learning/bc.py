@@ -1,0 +1,210 @@
+"""Behaviour cloning: regress the demonstrator's action from the observation."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.errors import ConfigError, join_problems
+
+DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
+
+
+@dataclass
+class TrainConfig:
+    """Behaviour-cloning run.
+
+    Attributes:
+        dataset: LeRobot dataset folder (default: the bundled sample).
+        out: where the checkpoint goes (default: policies/bc-<task>-<aircraft>-<policy>).
+        policy: policy type: mlp (default) or gru (recurrent).
+        epochs: passes over the training frames.
+        batch_size: frames (or windows, for gru) per gradient step.
+        lr: AdamW learning rate (cosine-decayed to 5 % over the run).
+        weight_decay: AdamW weight decay.
+        seed: seeds the split, the initialisation and the shuffling.
+        val_fraction: share of episodes held out for validation loss (whole episodes).
+        device: cpu, cuda, or auto (cuda when present).
+        hidden: hidden widths (mlp) or the GRU width (gru, first value).
+        sequence_length: gru only: training window in steps.
+    """
+
+    dataset: Path = DEFAULT_DATASET
+    out: Path | None = None
+    policy: str = "mlp"
+    epochs: int = 30
+    batch_size: int = 256
+    lr: float = 1e-3
+    weight_decay: float = 1e-4
+    seed: int = 0
+    val_fraction: float = 0.1
+    device: str = "cpu"
+    hidden: list[int] = field(default_factory=lambda: [256, 256])
+    sequence_length: int = 32
+
+    def __post_init__(self) -> None:
+        self.dataset = Path(self.dataset)
+        problems = []
+        if self.policy not in ("mlp", "gru"):
+            problems.append(f"policy={self.policy!r}: choose mlp or gru")
+        if self.epochs < 1 or self.batch_size < 1:
+            problems.append("epochs and batch_size must be >= 1")
+        if not (self.lr > 0 and math.isfinite(self.lr)):
+            problems.append(f"lr={self.lr} must be a positive number")
+        if not 0.0 <= self.val_fraction < 1.0:
+            problems.append(f"val_fraction={self.val_fraction} must lie in [0, 1)")
+        if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
+            problems.append(f"device={self.device!r}: use cpu, cuda, cuda:N or auto")
+        if problems:
+            raise ConfigError(join_problems("train config", problems))
+
+
+@dataclass
+class TrainResult:
+    out: Path
+    train_loss: list[float]
+    val_loss: list[float]
+    seconds: float
+    frames: int
+    meta: dict[str, Any]
+
+
+def resolve_device(device: str) -> str:
+    import torch
+
+    if device == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    if device.startswith("cuda") and not torch.cuda.is_available():
+        raise ConfigError(f"device={device!r} but no CUDA device is available; use cpu")
+    return device
+
+
+def env_of(frames: Any) -> dict[str, Any]:
+    """The task family, dynamic switch and aircraft the dataset was recorded on."""
+    tasks = set(frames.episodes.get("gymfg/task", []))
+    aircraft = set(frames.episodes.get("gymfg/aircraft", []))
+    if len(tasks) != 1 or len(aircraft) != 1:
+        return {"task": None, "dynamic": False, "aircraft": None}
+    task = tasks.pop()
+    return {
+        "task": task.removesuffix("-dynamic"),
+        "dynamic": task.endswith("-dynamic"),
+        "aircraft": aircraft.pop(),
+    }
+
+
+def train_bc(
+    cfg: TrainConfig,
+    on_epoch: Callable[[int, float, float], None] | None = None,
+    frames: Any = None,
+) -> TrainResult:
+    """Train, save the checkpoint and a loss-curve plot under ``cfg.out``."""
+    import torch
+
+    from gymfg_il.learning.data import TensorBatches, load_frames, split_by_episode
+    from gymfg_il.policies.factory import make_config, make_policy, save_policy
+
+    device = resolve_device(cfg.device)
+    frames = frames if frames is not None else load_frames(cfg.dataset)
+    train, val = split_by_episode(frames, cfg.val_fraction, cfg.seed)
+    torch.manual_seed(cfg.seed)
+    if cfg.policy == "gru":
+        pconf = make_config("gru", hidden=cfg.hidden[0], sequence_length=cfg.sequence_length)
+        sequence: int | None = cfg.sequence_length
+    else:
+        pconf = make_config("mlp", hidden=list(cfg.hidden))
+        sequence = None
+    policy = make_policy(pconf, frames.obs_stats, frames.action_stats).to(device)
+    batches = TensorBatches(train, cfg.batch_size, device, sequence, cfg.seed)
+    val_batches = TensorBatches(val, 4096, device, sequence, cfg.seed) if val else None
+    opt = torch.optim.AdamW(policy.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    steps = cfg.epochs * len(batches)
+    sched = torch.optim.lr_scheduler.LambdaLR(
+        opt, lambda s: 0.05 + 0.95 * 0.5 * (1 + math.cos(math.pi * min(s, steps) / steps))
+    )
+    train_loss, val_loss = [], []
+    started = time.perf_counter()
+    for epoch in range(cfg.epochs):
+        policy.train()
+        total, count = 0.0, 0
+        for obs, act in batches:
+            loss = policy.loss(obs, act)
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            opt.step()
+            sched.step()
+            total += float(loss.detach()) * len(obs)
+            count += len(obs)
+        train_loss.append(total / count)
+        val_loss.append(evaluate_loss(policy, val_batches) if val_batches else math.nan)
+        if on_epoch is not None:
+            on_epoch(epoch, train_loss[-1], val_loss[-1])
+    seconds = time.perf_counter() - started
+    env = env_of(frames)
+    name = (
+        f"bc-{env['task'] or 'task'}{'-dynamic' if env['dynamic'] else ''}-"
+        f"{env['aircraft'] or 'aircraft'}-{cfg.policy}"
+    )
+    out = Path(cfg.out) if cfg.out is not None else Path("policies") / name
+    meta = {
+        "name": name,
+        **env,
+        "observation_names": frames.observation_names,
+        "action_names": frames.action_names,
+        "fps": frames.fps,
+        "dataset": str(cfg.dataset),
+        "train": {
+            **{k: (str(v) if isinstance(v, Path) else v) for k, v in asdict(cfg).items()},
+            "device": device,
+            "frames": len(train),
+            "val_frames": len(val) if val else 0,
+            "train_loss": train_loss,
+            "val_loss": val_loss,
+            "seconds": seconds,
+        },
+    }
+    save_policy(policy.cpu(), out, meta, frames.obs_stats, frames.action_stats)
+    plot_losses(train_loss, val_loss, out / "loss.png", name)
+    (out / "train_log.json").write_text(
+        json.dumps({"train_loss": train_loss, "val_loss": val_loss}, indent=1)
+    )
+    return TrainResult(out, train_loss, val_loss, seconds, len(train) * cfg.epochs, meta)
+
+
+def evaluate_loss(policy: Any, batches: Any) -> float:
+    import torch
+
+    policy.eval()
+    total, count = 0.0, 0
+    with torch.no_grad():
+        for obs, act in batches:
+            total += float(policy.loss(obs, act)) * len(obs)
+            count += len(obs)
+    return total / count
+
+
+def plot_losses(train: list[float], val: list[float], path: Path, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    epochs = np.arange(1, len(train) + 1)
+    ax.semilogy(epochs, train, label="train")
+    if not all(math.isnan(v) for v in val):
+        ax.semilogy(epochs, val, label="validation (held-out episodes)")
+    ax.set_xlabel("epoch")
+    ax.set_ylabel("MSE (normalised actions)")
+    ax.set_title(title)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -1,0 +1,167 @@
+"""A LeRobot dataset as in-memory tensors, batched by indexing (no per-item Python).
+
+The dataset is opened with LeRobot's own ``LeRobotDataset``; its columns are taken from the
+Arrow table underneath in one piece each. An epoch is a permutation of frame indices (or of
+window starts, for recurrent policies); a batch is one gather.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.errors import ConfigError
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+
+@dataclass
+class Frames:
+    """Every frame of a dataset: observations, actions, and where each frame sits."""
+
+    obs: np.ndarray  # (N, n_obs) float32
+    action: np.ndarray  # (N, 4) float32
+    episode: np.ndarray  # (N,) int64
+    frame: np.ndarray  # (N,) int64
+    observation_names: list[str]
+    action_names: list[str]
+    fps: int
+    obs_stats: dict[str, np.ndarray]
+    action_stats: dict[str, np.ndarray]
+    episodes: dict[str, list[Any]] = field(default_factory=dict)  # per-episode metadata
+
+    def __len__(self) -> int:
+        return len(self.action)
+
+    def select(self, episodes: np.ndarray) -> Frames:
+        keep = np.isin(self.episode, episodes)
+        return Frames(
+            self.obs[keep],
+            self.action[keep],
+            self.episode[keep],
+            self.frame[keep],
+            self.observation_names,
+            self.action_names,
+            self.fps,
+            self.obs_stats,
+            self.action_stats,
+            self.episodes,
+        )
+
+
+def _column(table: Any, name: str) -> np.ndarray:
+    import pyarrow as pa
+
+    col = table.column(name).combine_chunks()
+    if pa.types.is_fixed_size_list(col.type):
+        flat = col.flatten().to_numpy(zero_copy_only=False)
+        return flat.reshape(len(col), col.type.list_size)
+    if pa.types.is_list(col.type) or pa.types.is_large_list(col.type):
+        return np.stack(col.to_numpy(zero_copy_only=False))
+    return col.to_numpy(zero_copy_only=False)
+
+
+def load_frames(root: Path) -> Frames:
+    """Open the LeRobot dataset at ``root`` and take its frames into memory."""
+    root = Path(root)
+    if not (root / "meta" / "info.json").is_file():
+        raise ConfigError(
+            f"no LeRobot dataset at {root} (no meta/info.json); collect one with "
+            "`python -m gymfg_il.collect autopilot --out DIR` and pass DIR/dataset"
+        )
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    ds = LeRobotDataset("gymfg/local", root=root, video_backend="pyav")
+    features = ds.meta.features
+    for key in ("observation.state", "action"):
+        if key not in features:
+            raise ConfigError(f"the dataset at {root} has no {key!r} feature")
+    table = ds.hf_dataset.data.table
+    stats = ds.meta.stats
+    episodes: dict[str, list[Any]] = {}
+    if ds.meta.episodes is not None:
+        for name in ds.meta.episodes.column_names:
+            if name.startswith("gymfg/") or name in ("episode_index", "length"):
+                episodes[name] = list(ds.meta.episodes[name])
+    return Frames(
+        obs=_column(table, "observation.state").astype(np.float32),
+        action=_column(table, "action").astype(np.float32),
+        episode=_column(table, "episode_index").astype(np.int64),
+        frame=_column(table, "frame_index").astype(np.int64),
+        observation_names=list(features["observation.state"]["names"]),
+        action_names=list(features["action"]["names"]),
+        fps=int(ds.meta.fps),
+        obs_stats={k: np.asarray(stats["observation.state"][k]) for k in ("mean", "std")},
+        action_stats={k: np.asarray(stats["action"][k]) for k in ("mean", "std")},
+        episodes=episodes,
+    )
+
+
+def split_by_episode(
+    frames: Frames, val_fraction: float, seed: int
+) -> tuple[Frames, Frames | None]:
+    """Hold out whole episodes for validation (never frames of a training episode)."""
+    if not 0.0 <= val_fraction < 1.0:
+        raise ConfigError(f"val_fraction={val_fraction} must lie in [0, 1)")
+    ids = np.unique(frames.episode)
+    n_val = round(len(ids) * val_fraction)
+    if val_fraction > 0 and len(ids) > 1:
+        n_val = max(1, min(n_val, len(ids) - 1))
+    if n_val == 0:
+        return frames, None
+    rng = np.random.default_rng(seed)
+    val = rng.choice(ids, n_val, replace=False)
+    return frames.select(np.setdiff1d(ids, val)), frames.select(val)
+
+
+class TensorBatches:
+    """Shuffled batches from tensors on ``device``: frames, or windows of ``sequence`` steps
+    that never cross an episode boundary."""
+
+    def __init__(
+        self,
+        frames: Frames,
+        batch_size: int,
+        device: str = "cpu",
+        sequence: int | None = None,
+        seed: int = 0,
+    ) -> None:
+        import torch
+
+        self.torch = torch
+        self.obs = torch.as_tensor(frames.obs, device=device)
+        self.action = torch.as_tensor(frames.action, device=device)
+        self.batch_size = batch_size
+        self.sequence = sequence
+        if sequence is None:
+            starts: np.ndarray = np.arange(len(frames))
+        else:
+            # window i..i+sequence-1 stays inside one episode
+            ends = np.arange(len(frames)) + sequence - 1
+            ok = ends < len(frames)
+            ok[ok] &= frames.episode[ends[ok]] == frames.episode[ok]
+            starts = np.flatnonzero(ok)
+            if len(starts) == 0:
+                raise ConfigError(f"no episode is {sequence} steps long; lower sequence_length")
+        self.starts = torch.as_tensor(starts, device=device)
+        self.offsets = torch.arange(sequence or 1, device=device)
+        self.generator = torch.Generator(device="cpu").manual_seed(seed)
+
+    def __len__(self) -> int:
+        return (len(self.starts) + self.batch_size - 1) // self.batch_size
+
+    def __iter__(self) -> Iterator[tuple[Any, Any]]:
+        torch = self.torch
+        order = self.starts[
+            torch.randperm(len(self.starts), generator=self.generator).to(self.starts.device)
+        ]
+        for i in range(0, len(order), self.batch_size):
+            idx = order[i : i + self.batch_size]
+            if self.sequence is not None:
+                idx = idx[:, None] + self.offsets
+            yield self.obs[idx], self.action[idx]

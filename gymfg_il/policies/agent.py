@@ -1,0 +1,55 @@
+"""A trained policy as an Agent: numpy observation in, clipped action out, memory reset
+at every episode."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.errors import ConfigError
+
+
+class PolicyAgent:
+    """Fly a checkpoint (``load``) or a policy module in any env whose task observes the
+    same variables the policy was trained on."""
+
+    def __init__(self, policy: Any, meta: dict[str, Any], device: str = "cpu") -> None:
+        import torch
+
+        self.policy, self.meta, self.device = policy, meta, device
+        self.observation_names: list[str] = list(meta["observation_names"])
+        self._torch = torch
+        self._state: object = None
+        self._low = np.array([-1.0, -1.0, -1.0, 0.0])
+        self._high = np.ones(4)
+
+    @classmethod
+    def load(cls, path: Path, device: str = "cpu") -> PolicyAgent:
+        from gymfg_il.policies.factory import load_policy
+
+        policy, meta = load_policy(path, device)
+        return cls(policy, meta, device)
+
+    @property
+    def name(self) -> str:
+        return str(self.meta.get("name", self.meta.get("type", "policy")))
+
+    def check_observation(self, names: Sequence[str]) -> None:
+        if list(names) != self.observation_names:
+            raise ConfigError(
+                f"the policy observes {self.observation_names} but this env gives "
+                f"{list(names)}; fly it on the task it was trained on "
+                f"({self.meta.get('task')} on {self.meta.get('aircraft')})"
+            )
+
+    def reset(self, seed: int | None = None) -> None:
+        self._state = None
+
+    def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        torch = self._torch
+        obs = torch.as_tensor(np.asarray(observation, dtype=np.float32), device=self.device)
+        action, self._state = self.policy.act(obs.unsqueeze(0), self._state)
+        return np.clip(action[0].double().cpu().numpy(), self._low, self._high)

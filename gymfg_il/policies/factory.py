@@ -1,0 +1,95 @@
+"""Finding policies by name, and saving/loading checkpoints (safetensors + JSON config)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.errors import ConfigError
+from gymfg_il.policies.configuration_gru import GRUConfig
+from gymfg_il.policies.configuration_mlp import MLPConfig
+
+CONFIGS: dict[str, type] = {"mlp": MLPConfig, "gru": GRUConfig}
+CONFIG_FILE, WEIGHTS_FILE = "config.json", "model.safetensors"
+
+
+def make_config(kind: str, **kwargs: Any) -> MLPConfig | GRUConfig:
+    try:
+        cls = CONFIGS[kind]
+    except KeyError:
+        raise ConfigError(f"unknown policy {kind!r}; choose one of {sorted(CONFIGS)}") from None
+    return cls(**kwargs)
+
+
+def make_policy(
+    config: MLPConfig | GRUConfig,
+    obs_stats: dict[str, np.ndarray],
+    action_stats: dict[str, np.ndarray],
+) -> Any:
+    """A fresh policy module for ``config`` with normalisation from the given statistics."""
+    if config.type == "mlp":
+        from gymfg_il.policies.modeling_mlp import MLPPolicy
+
+        return MLPPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
+    from gymfg_il.policies.modeling_gru import GRUPolicy
+
+    return GRUPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
+
+
+def _stats_json(stats: dict[str, np.ndarray]) -> dict[str, list[float]]:
+    return {k: np.asarray(stats[k], dtype=np.float64).tolist() for k in ("mean", "std")}
+
+
+def save_policy(
+    policy: Any,
+    out: Path,
+    meta: dict[str, Any],
+    obs_stats: dict[str, np.ndarray],
+    action_stats: dict[str, np.ndarray],
+) -> Path:
+    """Write ``out/config.json`` and ``out/model.safetensors``."""
+    from safetensors.torch import save_file
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    config = {
+        "type": policy.config.type,
+        "policy": asdict(policy.config),
+        "obs_stats": _stats_json(obs_stats),
+        "action_stats": _stats_json(action_stats),
+        **meta,
+    }
+    (out / CONFIG_FILE).write_text(json.dumps(config, indent=2))
+    state = {k: v.detach().cpu().contiguous() for k, v in policy.state_dict().items()}
+    save_file(state, str(out / WEIGHTS_FILE))
+    return out
+
+
+def read_config(path: Path) -> dict[str, Any]:
+    path = Path(path)
+    if not (path / CONFIG_FILE).is_file() or not (path / WEIGHTS_FILE).is_file():
+        raise ConfigError(
+            f"{path} is not a policy checkpoint (needs {CONFIG_FILE} and {WEIGHTS_FILE}); "
+            "train one with `python -m gymfg_il.train bc`"
+        )
+    data: dict[str, Any] = json.loads((path / CONFIG_FILE).read_text())
+    return data
+
+
+def load_policy(path: Path, device: str = "cpu") -> tuple[Any, dict[str, Any]]:
+    """(policy module in eval mode on ``device``, its config dict)."""
+    from safetensors.torch import load_file
+
+    meta = read_config(path)
+    policy_fields = dict(meta["policy"])
+    kind = policy_fields.pop("type", meta["type"])
+    config = make_config(kind, **policy_fields)
+    obs = {k: np.array(v) for k, v in meta["obs_stats"].items()}
+    act = {k: np.array(v) for k, v in meta["action_stats"].items()}
+    policy = make_policy(config, obs, act)
+    policy.load_state_dict(load_file(str(Path(path) / WEIGHTS_FILE)))
+    return policy.to(device).eval(), meta
