@@ -8,6 +8,11 @@ Rows (name, value, unit, target, higher_is_better):
   controls set through cached nodes, 12 ``FGFDMExec.run()``, the catalogue read into an array).
 - per_aircraft_8_vs_1: aircraft-steps/s of an OfflineEnv team of 8 c172p divided by that of a
   team of 1.
+- dataset_build_frames_per_s: building a LeRobot dataset from MCAP logs (reading included),
+  beside LeRobot's own add_frame + save_episode path.
+- train_pipeline_frames_per_s: frames/s our in-memory batches deliver, beside stock
+  LeRobotDataset + DataLoader.
+- rollout_workers_2_vs_1: speed-up of seeded evaluation episodes on 2 worker processes.
 
 Each side is timed in alternating rounds and the best round of each is compared, so a busy
 moment on the machine does not land on one side only.
@@ -168,40 +173,104 @@ def dataset_build(episodes: int) -> dict[str, float]:
     return {"ours": ours, "stock": stock, "ratio": ours / stock}
 
 
+def train_pipeline(dataset: Path, stock_items: int) -> dict[str, float]:
+    """Frames/s delivered to the model: our in-memory tensor batches against stock
+    ``LeRobotDataset`` + ``torch.utils.data.DataLoader`` (per-item ``__getitem__``)."""
+    import os
+
+    os.environ.setdefault("HF_HUB_OFFLINE", "1")
+    import torch
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    from gymfg_il.learning.data import TensorBatches, load_frames
+
+    frames = load_frames(dataset)
+    batches = TensorBatches(frames, 256, seed=0)
+    t0 = time.perf_counter()
+    delivered = 0
+    for _ in range(20):
+        for obs, _act in batches:
+            delivered += len(obs)
+    ours = delivered / (time.perf_counter() - t0)
+
+    ds = LeRobotDataset("gymfg/bench", root=dataset, video_backend="pyav")
+    subset = torch.utils.data.Subset(ds, range(stock_items))
+    loader = torch.utils.data.DataLoader(subset, batch_size=256, shuffle=True, num_workers=0)
+    t0 = time.perf_counter()
+    delivered = 0
+    for batch in loader:
+        delivered += len(batch["action"])
+    stock = delivered / (time.perf_counter() - t0)
+    return {"ours": ours, "stock": stock, "ratio": ours / stock}
+
+
+def rollout_workers(episodes: int, rounds: int) -> dict[str, float]:
+    """Wall time of evaluation episodes (controller, altitude, c172p, 90 s) on 1 and 2
+    worker processes, pool start included; best of alternating rounds."""
+    from gymfg_il.evaluation.parallel import fly_many
+    from gymfg_il.parallel import AgentSpec, EnvSpec
+
+    spec, agent, seeds = EnvSpec(), AgentSpec.controller(), range(episodes)
+    best = {1: float("inf"), 2: float("inf")}
+    results = {}
+    for _ in range(rounds):
+        for workers in (1, 2):
+            t0 = time.perf_counter()
+            results[workers] = fly_many(spec, agent, seeds, workers=workers)
+            best[workers] = min(best[workers], time.perf_counter() - t0)
+    pairs = zip(results[1], results[2], strict=True)
+    assert all((a.rewards == b.rewards).all() for a, b in pairs), "workers changed results"
+    return {"one": best[1], "two": best[2], "ratio": best[1] / best[2]}
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     p.add_argument("--json", type=Path, help="write the rows to this JSON file")
     p.add_argument("--quick", action="store_true", help="fewer, shorter rounds (a smoke run)")
     args = p.parse_args(argv)
     steps, rounds = (200, 2) if args.quick else (900, 7)
+    rows: list[dict[str, object]] = []
 
-    rows = []
+    def row(name: str, value: float, unit: str, target: float) -> None:
+        rows.append(
+            {"name": name, "value": value, "unit": unit, "target": target, "higher_is_better": True}
+        )
+
     r = env_vs_raw(steps, rounds)
-    print(f"env.step (c172p, 10 Hz)      {r['env']:9,.0f} steps/s")
-    print(f"raw FGFDMExec, same I/O      {r['raw']:9,.0f} steps/s")
-    print(f"env_step_vs_raw_jsbsim       {r['ratio']:9.3f}   (target >= 0.90)\n")
-    rows.append(
-        {
-            "name": "env_step_vs_raw_jsbsim",
-            "value": r["ratio"],
-            "unit": "ratio",
-            "target": 0.90,
-            "higher_is_better": True,
-        }
-    )
+    print(f"env.step (c172p, 10 Hz)          {r['env']:11,.0f} steps/s")
+    print(f"raw FGFDMExec, same I/O          {r['raw']:11,.0f} steps/s")
+    print(f"env_step_vs_raw_jsbsim           {r['ratio']:11.3f}   (target >= 0.90)\n")
+    row("env_step_vs_raw_jsbsim", r["ratio"], "ratio", 0.90)
+
     r = eight_vs_one(steps // 2, rounds)
-    print(f"1 aircraft                   {r['one']:9,.0f} aircraft-steps/s")
-    print(f"8 aircraft                   {r['eight']:9,.0f} aircraft-steps/s")
-    print(f"per_aircraft_8_vs_1          {r['ratio']:9.3f}   (target >= 0.85)")
-    rows.append(
-        {
-            "name": "per_aircraft_8_vs_1",
-            "value": r["ratio"],
-            "unit": "ratio",
-            "target": 0.85,
-            "higher_is_better": True,
-        }
+    print(f"1 aircraft                       {r['one']:11,.0f} aircraft-steps/s")
+    print(f"8 aircraft                       {r['eight']:11,.0f} aircraft-steps/s")
+    print(f"per_aircraft_8_vs_1              {r['ratio']:11.3f}   (target >= 0.85)\n")
+    row("per_aircraft_8_vs_1", r["ratio"], "ratio", 0.85)
+
+    r = rollout_workers(6 if args.quick else 16, 2 if args.quick else 4)
+    print(f"rollouts, 1 worker               {r['one']:11.2f} s")
+    print(f"rollouts, 2 workers              {r['two']:11.2f} s")
+    print(f"rollout_workers_2_vs_1           {r['ratio']:11.2f}x  (target >= 1.8)\n")
+    row("rollout_workers_2_vs_1", r["ratio"], "ratio", 1.8)
+
+    r = dataset_build(5 if args.quick else 20)
+    print(f"LeRobot add_frame+save_episode   {r['stock']:11,.0f} frames/s (from memory)")
+    print(
+        f"dataset_build_frames_per_s       {r['ours']:11,.0f} frames/s (from MCAP logs), "
+        f"{r['ratio']:.1f}x  (target >= 20,000)\n"
     )
+    row("dataset_build_frames_per_s", r["ours"], "frames/s", 20000)
+
+    sample = Path(__file__).resolve().parents[1] / "datasets/sample-altitude-c172p/dataset"
+    r = train_pipeline(sample, 1000 if args.quick else 4000)
+    print(f"LeRobotDataset + DataLoader      {r['stock']:11,.0f} frames/s")
+    print(
+        f"train_pipeline_frames_per_s      {r['ours']:11,.0f} frames/s, {r['ratio']:,.0f}x  "
+        "(target >= 500,000)"
+    )
+    row("train_pipeline_frames_per_s", r["ours"], "frames/s", 500000)
+
     if args.json:
         args.json.write_text(json.dumps(rows, indent=2))
         print(f"\nwrote {args.json}")

@@ -77,12 +77,10 @@ class AgentSpec:
 
 
 def _worker_init() -> None:
-    try:
-        import torch
+    import sys
 
-        torch.set_num_threads(1)  # one core per worker
-    except ImportError:
-        pass
+    if "torch" in sys.modules:  # one core per worker
+        sys.modules["torch"].set_num_threads(1)
 
 
 def _call[T](job: tuple[Callable[..., T], tuple[Any, ...]]) -> T:
@@ -101,6 +99,11 @@ def map_seeds[T](
         for seed in seeds:
             yield fn(*args, seed)
         return
-    ctx = mp.get_context("spawn")
+    # fork: workers start in milliseconds with everything imported (the parent has run no
+    # torch kernels, so no thread pool is forked); spawn elsewhere.
+    method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
+    ctx = mp.get_context(method)
     with ctx.Pool(min(workers, len(seeds)), initializer=_worker_init) as pool:
-        yield from pool.imap(_call, [(fn, (*args, seed)) for seed in seeds])
+        jobs = [(fn, (*args, seed)) for seed in seeds]
+        chunk = max(1, len(seeds) // (4 * workers))
+        yield from pool.imap(_call, jobs, chunksize=chunk)

@@ -4,8 +4,19 @@ from gymfg_il import demo
 
 
 def test_main_job_runs_the_whole_loop_and_writes_a_report(tmp_path, capsys):
-    code = demo.main(["--epochs", "3", "--episodes", "2", "--workers", "1",
-                      "--runs", str(tmp_path), "--no-progress"])
+    code = demo.main(
+        [
+            "--epochs",
+            "3",
+            "--episodes",
+            "2",
+            "--workers",
+            "1",
+            "--runs",
+            str(tmp_path),
+            "--no-progress",
+        ]
+    )
     assert code == 0
     out = capsys.readouterr().out
     run = next(tmp_path.iterdir())
