@@ -5,6 +5,7 @@
     python -m gymfg_il.collect recover DIR                   # rebuild DIR/dataset from DIR/logs
     python -m gymfg_il.collect replay DIR                    # re-fly logged episodes, compare
     python -m gymfg_il.collect dagger --policy P --out DIR   # DAgger with the controller
+    python -m gymfg_il.collect manual --device keyboard --out DIR   # a person flies
 
 A session folder holds ``logs/`` (one MCAP log per session: every step, the write-ahead log)
 and ``dataset/`` (LeRobot v3.0). Collecting into an existing folder appends.
@@ -81,7 +82,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    sub = p.add_subparsers(dest="command", metavar="{autopilot,dagger,recover,replay,RECIPE.toml}")
+    sub = p.add_subparsers(
+        dest="command", metavar="{autopilot,manual,dagger,recover,replay,RECIPE.toml}"
+    )
     auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
     _autopilot_args(auto, recipe=False)
     rec = sub.add_parser(
@@ -90,6 +93,47 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         "(after a crash or kill: keeps every completed episode)",
     )
     rec.add_argument("dir", type=Path, help="session folder")
+    man = sub.add_parser(
+        "manual",
+        help="a person flies (keyboard, mouse or joystick) in a "
+        "pygame window; every completed episode is saved at once",
+    )
+    man.add_argument(
+        "--device",
+        default="keyboard",
+        choices=["keyboard", "mouse", "joystick"],
+        help="input device (default: keyboard)",
+    )
+    man.add_argument("--aircraft", default="c172p", help="JSBSim model (default: c172p)")
+    man.add_argument("--task", default="altitude", help="task family (default: altitude)")
+    man.add_argument("--dynamic", action="store_true", help="moving targets")
+    man.add_argument(
+        "--episode-time", type=float, default=90.0, help="seconds per episode (default: 90)"
+    )
+    man.add_argument(
+        "--fps",
+        type=int,
+        default=30,
+        help="real-time loop and dataset rate, a divisor of 120 (default: 30)",
+    )
+    man.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    man.add_argument(
+        "--episodes",
+        type=int,
+        default=0,
+        help="stop after this many saved episodes (default: 0 = until Q)",
+    )
+    man.add_argument(
+        "--assist",
+        help="'controller' or a policy folder: it flies until you "
+        "take over with T (your frames are flagged as interventions)",
+    )
+    man.add_argument(
+        "--out",
+        type=Path,
+        default=Path("datasets/manual"),
+        help="session folder (default: datasets/manual)",
+    )
     dag = sub.add_parser(
         "dagger",
         help="the policy flies, the controller labels what it "
@@ -162,6 +206,8 @@ def main(argv: list[str] | None = None) -> int:
             return replay(args.log, args.episode)
         if args.command == "dagger":
             return dagger(args)
+        if args.command == "manual":
+            return manual_from_args(args)
         from gymfg_il.collectors.config import CollectConfig
 
         options = {
@@ -169,6 +215,12 @@ def main(argv: list[str] | None = None) -> int:
             for k, v in vars(args).items()
             if k not in ("command", "recipe", "no_progress", "workers") and v is not None
         }
+        if args.command == "recipe":
+            from gymfg_il.collectors.config import CollectConfig as _C
+
+            recipe = _C.from_recipe(args.recipe, **options)
+            if recipe.kind == "manual":
+                return manual(recipe)
         cfg = (
             CollectConfig.from_recipe(args.recipe, **options)
             if args.command == "recipe"
@@ -203,6 +255,53 @@ def collect(cfg: object, progress: bool = True, workers: int = 1) -> int:
     print(f"logged {len(result.episodes)} episodes ({result.steps} steps) to {result.log}")
     report = build_from_logs(sorted((cfg.out / LOGS).glob("*.mcap")), cfg.out / DATASET)
     _report_build(report, cfg.out / DATASET)
+    return 0
+
+
+def manual_from_args(args: argparse.Namespace) -> int:
+    from gymfg_il.collectors.config import CollectConfig
+
+    cfg = CollectConfig(
+        kind="manual",
+        aircraft=args.aircraft,
+        task=args.task,
+        dynamic=args.dynamic,
+        episodes=max(args.episodes, 1),
+        episode_time_s=args.episode_time,
+        agent_hz=args.fps,
+        seed=args.seed,
+        out=args.out,
+        device=args.device,
+        assist=args.assist,
+    )
+    if args.episodes == 0:
+        cfg.episodes = 0
+    return manual(cfg)
+
+
+def manual(cfg: object) -> int:
+    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.manual.session import ManualSession
+    from gymfg_il.parallel import EnvSpec
+
+    assert isinstance(cfg, CollectConfig)
+    spec = EnvSpec(
+        cfg.task, cfg.aircraft, cfg.dynamic, cfg.agent_hz, cfg.episode_time_s, dict(cfg.task_kwargs)
+    )
+    session = ManualSession(
+        spec,
+        cfg.out,
+        cfg.device,
+        {"keyboard": cfg.keyboard, "mouse": cfg.mouse, "joystick": cfg.joystick},
+        cfg.assist,
+        cfg.seed,
+        cfg.episodes,
+    )
+    stats = session.run()
+    print(
+        f"saved {stats.saved} episode(s), discarded {stats.discarded}; dataset: "
+        f"{stats.dataset or 'none yet'}"
+    )
     return 0
 
 

@@ -22,7 +22,7 @@ class CollectConfig:
     """A collection session.
 
     Attributes:
-        kind: who flies: ``autopilot`` (the task's PID controller).
+        kind: who flies: ``autopilot`` (the task's PID controller) or ``manual`` (a person).
         aircraft: JSBSim model.
         task: task family (altitude, roll, pitch, heading, airspeed, level).
         dynamic: moving targets.
@@ -34,6 +34,12 @@ class CollectConfig:
             dataset keeps the demonstrator's clean action as the label); 0 = none.
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
         task_kwargs: arguments of the task class (e.g. ``target_range``).
+        device: manual only: keyboard, mouse or joystick.
+        assist: manual only: ``controller`` or a policy folder that flies until the person
+            takes over (T); the person's frames are flagged as interventions.
+        keyboard: manual only: key bindings (see ``manual.bindings.KeyboardBindings``).
+        mouse: manual only: mouse bindings (``MouseBindings``).
+        joystick: manual only: joystick axes, dead zones, expo, buttons (``JoystickBindings``).
     """
 
     kind: str = "autopilot"
@@ -47,12 +53,19 @@ class CollectConfig:
     noise: float = 0.0
     out: Path = Path("datasets/autopilot")
     task_kwargs: dict[str, Any] = field(default_factory=dict)
+    device: str = "keyboard"
+    assist: str | None = None
+    keyboard: dict[str, Any] = field(default_factory=dict)
+    mouse: dict[str, Any] = field(default_factory=dict)
+    joystick: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.out = Path(self.out)
         problems = []
-        if self.kind != "autopilot":
-            problems.append(f"kind={self.kind!r}: only 'autopilot' collects without a person")
+        if self.kind not in ("autopilot", "manual"):
+            problems.append(f"kind={self.kind!r}: choose autopilot or manual")
+        if self.device not in ("keyboard", "mouse", "joystick"):
+            problems.append(f"device={self.device!r}: choose keyboard, mouse or joystick")
         if self.task in ("dummy",):
             problems.append("task 'dummy' has no controller to demonstrate it")
         else:

@@ -1,0 +1,174 @@
+"""The ManualController: a person's keyboard, mouse or joystick as an Agent.
+
+The session loop hands it each frame's pygame events (``handle``); ``act`` returns the
+controls as they stand. Keyboard and joystick state is built from events (KEYDOWN/KEYUP,
+JOYAXISMOTION, ...), never from polling, so injected events drive it exactly like real ones.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.errors import ConfigError
+from gymfg_il.manual.bindings import JoystickBindings, KeyboardBindings, MouseBindings
+
+DEVICES = ("keyboard", "mouse", "joystick")
+
+
+def _pg() -> Any:
+    import pygame
+
+    return pygame
+
+
+class ManualController:
+    """Agent flown by a person through pygame.
+
+    Args:
+        device: ``keyboard``, ``mouse`` (stick from the pointer, throttle and rudder on the
+            keyboard) or ``joystick``.
+        keyboard, mouse, joystick: the bindings (defaults: FlightGear-like).
+        throttle: throttle at the start of each episode.
+        window_size: the window the mouse stick is centred in.
+    """
+
+    def __init__(
+        self,
+        device: str = "keyboard",
+        keyboard: KeyboardBindings | None = None,
+        mouse: MouseBindings | None = None,
+        joystick: JoystickBindings | None = None,
+        throttle: float = 0.7,
+        window_size: tuple[int, int] = (900, 600),
+    ) -> None:
+        if device not in DEVICES:
+            raise ConfigError(f"device={device!r}: choose one of {', '.join(DEVICES)}")
+        self.device = device
+        self.keys = keyboard or KeyboardBindings()
+        self.mouse = mouse or MouseBindings()
+        self.joy = joystick or JoystickBindings()
+        self.start_throttle = throttle
+        self.window_size = window_size
+        self.values = np.array([0.0, 0.0, 0.0, throttle])
+        self.held: set[str] = set()
+        self.joysticks: dict[int, Any] = {}  # instance id -> pygame Joystick (or None)
+        self.status = ""
+        self._key_of = self._index_keys()
+
+    def _index_keys(self) -> dict[str, tuple[int, float]]:
+        """key name -> (control index, direction)."""
+        k = self.keys
+        out: dict[str, tuple[int, float]] = {}
+        for names, idx, sign in (
+            (k.aileron_left, 0, -1.0),
+            (k.aileron_right, 0, 1.0),
+            (k.elevator_down, 1, 1.0),
+            (k.elevator_up, 1, -1.0),
+            (k.rudder_left, 2, -1.0),
+            (k.rudder_right, 2, 1.0),
+            (k.throttle_up, 3, 1.0),
+            (k.throttle_down, 3, -1.0),
+        ):
+            for name in names:
+                out[name] = (idx, sign)
+        return out
+
+    # -- Agent ---------------------------------------------------------------------------
+    def reset(self, seed: int | None = None) -> None:
+        self.values = np.array([0.0, 0.0, 0.0, self.start_throttle])
+        self.held.clear()
+
+    def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        return self.values.copy()
+
+    def set_throttle(self, throttle: float) -> None:
+        self.values[3] = throttle
+
+    # -- input ---------------------------------------------------------------------------
+    def handle(self, events: Iterable[Any], dt: float) -> list[str]:
+        """Apply one frame of events; returns session commands from joystick buttons."""
+        pg = _pg()
+        commands: list[str] = []
+        for ev in events:
+            if ev.type == pg.KEYDOWN:
+                self.held.add(pg.key.name(ev.key))
+                if pg.key.name(ev.key) in self.keys.center:
+                    self.values[:3] = 0.0
+            elif ev.type == pg.KEYUP:
+                self.held.discard(pg.key.name(ev.key))
+            elif ev.type == pg.MOUSEMOTION and self.device == "mouse":
+                self._mouse(ev.pos)
+            elif self.device == "joystick":
+                commands += self._joystick_event(pg, ev)
+        self._keyboard(dt, surfaces=self.device == "keyboard")
+        return commands
+
+    def _keyboard(self, dt: float, surfaces: bool) -> None:
+        k = self.keys
+        moved = [False] * 4
+        for name in self.held:
+            hit = self._key_of.get(name)
+            if hit is None:
+                continue
+            idx, sign = hit
+            if idx < 3 and not surfaces and not (self.device == "mouse" and idx == 2):
+                continue
+            if (
+                idx == 3
+                and self.device == "joystick"
+                and "throttle" in self.joy.axes
+                and self.joysticks
+            ):
+                continue
+            rate = k.throttle_rate if idx == 3 else k.rate
+            self.values[idx] += sign * rate * dt
+            moved[idx] = True
+        if k.centering:
+            step = k.centering * dt
+            for idx in range(3):
+                keyboard_axis = surfaces or (self.device == "mouse" and idx == 2)
+                if keyboard_axis and not moved[idx]:
+                    v = self.values[idx]
+                    self.values[idx] = 0.0 if abs(v) <= step else v - step * np.sign(v)
+        np.clip(self.values, [-1.0, -1.0, -1.0, 0.0], 1.0, out=self.values)
+
+    def _mouse(self, pos: tuple[int, int]) -> None:
+        m = self.mouse
+        cx, cy = self.window_size[0] / 2, self.window_size[1] / 2
+        x = (pos[0] - cx) / m.span_px
+        y = -(pos[1] - cy) / m.span_px  # pointer up = stick forward = nose down (+elevator)
+        if m.invert_elevator:
+            y = -y
+        for idx, v in ((0, x), (1, y)):
+            v = max(-1.0, min(1.0, v))
+            self.values[idx] = 0.0 if abs(v) < m.dead_zone else v
+
+    def _joystick_event(self, pg: Any, ev: Any) -> list[str]:
+        if ev.type == pg.JOYDEVICEADDED:
+            try:
+                stick = pg.joystick.Joystick(ev.device_index)
+                self.joysticks[stick.get_instance_id()] = stick
+                self.status = f"joystick: {stick.get_name()}"
+            except (pg.error, AttributeError):  # an injected event: no device behind it
+                self.joysticks[getattr(ev, "instance_id", ev.device_index)] = None
+                self.status = "joystick connected"
+        elif ev.type == pg.JOYDEVICEREMOVED:
+            self.joysticks.pop(ev.instance_id, None)
+            if not self.joysticks:
+                self.values[:3] = 0.0  # no stick, no deflection; throttle stays
+                self.status = "joystick unplugged: surfaces centred, plug it back in"
+        elif ev.type == pg.JOYAXISMOTION:
+            for control, axis in self.joy.axes.items():
+                if axis == ev.axis:
+                    idx = ("aileron", "elevator", "rudder", "throttle").index(control)
+                    self.values[idx] = self.joy.shape(control, ev.value)
+        elif ev.type == pg.JOYBUTTONDOWN:
+            command = self.joy.buttons.get(ev.button)
+            if command == "center":
+                self.values[:3] = 0.0
+            elif command:
+                return [command]
+        return []

@@ -1,0 +1,421 @@
+"""The manual collection session: a person flies, in real time, and every completed episode
+becomes data at once.
+
+Keys (also shown by the help overlay, H): Space starts an episode, E ends and saves it,
+Backspace discards it (the same case is flown again), P pauses, T takes over from the assisting
+controller or policy and hands back, Q or Esc quits. Each completed episode is made durable in
+the MCAP log and then added to the LeRobot dataset before the next one starts, so quitting or a
+crash loses nothing completed.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.collectors.session import (
+    DATASET,
+    check_appendable,
+    check_out_folder,
+    new_log_path,
+    session_record,
+)
+from gymfg_il.manual.bindings import (
+    JoystickBindings,
+    KeyboardBindings,
+    MouseBindings,
+    from_table,
+)
+from gymfg_il.manual.controller import ManualController
+from gymfg_il.manual.gui import ControlsGUI, GuiFrame
+from gymfg_il.parallel import AgentSpec, EnvSpec
+from gymfg_il.recording.writer import TrajectoryWriter
+from gymfg_il.sim.properties import BY_NAME, INDEX
+
+log = logging.getLogger(__name__)
+
+COMMAND_KEYS = {
+    "space": "start",
+    "e": "end",
+    "backspace": "discard",
+    "p": "pause",
+    "t": "takeover",
+    "q": "quit",
+    "escape": "quit",
+    "h": "help",
+    "f1": "help",
+}
+SHOWN = (
+    "altitude_ft",
+    "airspeed_kts",
+    "vertical_speed_fps",
+    "heading_deg",
+    "roll_deg",
+    "pitch_deg",
+    "alpha_deg",
+    "beta_deg",
+    "thrust_lbs",
+)
+
+
+def help_lines(device: str, kb: KeyboardBindings) -> list[str]:
+    def keys(names: list[str]) -> str:
+        return " / ".join(names)
+
+    lines = [
+        "SESSION  Space: start episode   E: end + save   Backspace: discard + fly again",
+        "         P: pause   T: take over / hand back   Q or Esc: quit   H: this help",
+    ]
+    if device == "mouse":
+        lines.append("STICK    the mouse pointer (offset from the window centre)")
+    elif device == "joystick":
+        lines.append("STICK    joystick axes (see the recipe's [collector.joystick])")
+    else:
+        lines += [
+            f"AILERON  {keys(kb.aileron_left)}  |  {keys(kb.aileron_right)}",
+            f"ELEVATOR {keys(kb.elevator_down)} (nose down)  |  {keys(kb.elevator_up)} (nose up)",
+        ]
+    lines += [
+        f"RUDDER   {keys(kb.rudder_left)}  |  {keys(kb.rudder_right)}",
+        f"THROTTLE {keys(kb.throttle_up)}  |  {keys(kb.throttle_down)}",
+        f"CENTRE   {keys(kb.center)}  (surfaces return to centre at {kb.centering:g}/s)",
+    ]
+    return lines
+
+
+@dataclass
+class SessionStats:
+    saved: int = 0
+    discarded: int = 0
+    frames: int = 0
+    periods: list[float] = field(default_factory=list)
+    dataset: Path | None = None
+
+
+class ManualSession:
+    """Run the collection loop.
+
+    Args:
+        env_spec: what to fly.
+        out: session folder (``logs/``, ``dataset/``).
+        device: keyboard, mouse or joystick.
+        bindings: recipe tables ``{"keyboard": {...}, "mouse": {...}, "joystick": {...}}``.
+        assist: None, ``"controller"`` or a policy checkpoint path: it flies unless the human
+            takes over (T); the human's frames are flagged as interventions.
+        seed: seed of the first episode (a discarded episode is flown again with its seed).
+        max_episodes: stop after this many saved episodes (0 = until quit).
+        realtime: pace frames to the wall clock at the env's rate.
+        on_frame: called at the start of each frame (tests inject events with it).
+    """
+
+    def __init__(
+        self,
+        env_spec: EnvSpec,
+        out: Path,
+        device: str = "keyboard",
+        bindings: dict[str, dict[str, Any]] | None = None,
+        assist: str | None = None,
+        seed: int = 0,
+        max_episodes: int = 0,
+        realtime: bool = True,
+        on_frame: Callable[[int, ManualSession], None] | None = None,
+    ) -> None:
+        bindings = bindings or {}
+        out = Path(out)
+        check_out_folder(out)
+        self.spec, self.out, self.seed, self.max_episodes = env_spec, out, seed, max_episodes
+        self.realtime, self.on_frame = realtime, on_frame
+        self.env = env_spec.make()
+        check_appendable(out, self.env.observation_names, env_spec.agent_hz)
+        self.kb = from_table(KeyboardBindings, bindings.get("keyboard"), "[collector.keyboard]")
+        self.human = ManualController(
+            device,
+            self.kb,
+            from_table(MouseBindings, bindings.get("mouse"), "[collector.mouse]"),
+            from_table(JoystickBindings, bindings.get("joystick"), "[collector.joystick]"),
+            throttle=self.env.aircraft.profile.cruise_throttle,
+        )
+        self.assist_name = (
+            None if assist is None else ("controller" if assist == "controller" else "policy")
+        )
+        self.assistant = None
+        if assist is not None:
+            spec = (
+                AgentSpec.controller() if assist == "controller" else AgentSpec.policy(Path(assist))
+            )
+            self.assistant = spec.make(self.env)
+        self.source = "human" if assist is None else f"{self.assist_name}+human"
+        self.help = help_lines(device, self.kb)
+        self.gui = ControlsGUI(title=f"GymFG-IL: {env_spec.task} on {self.env.aircraft.model}")
+        self.human.window_size = self.gui.size
+        self.stats = SessionStats()
+        self.state = "idle"
+        self.human_flies = assist is None
+        self.show_help = True
+        self.episode = 0
+        self.next_seed = seed  # a discarded episode is flown again with its seed
+        self.last_action = np.array([0.0, 0.0, 0.0, self.env.aircraft.profile.cruise_throttle])
+        self.message = "Space: start an episode"
+        self.writer: TrajectoryWriter | None = None
+        self.updater = DatasetUpdater(out)
+
+    # -- episodes --------------------------------------------------------------------------
+    def _writer(self) -> TrajectoryWriter:
+        if self.writer is None:
+            record = session_record(self.spec, self.source, 0.0, device=self.human.device)
+            self.writer = TrajectoryWriter(
+                new_log_path(self.out, "manual"), record, ["ego"], self.env.dt
+            )
+        return self.writer
+
+    def _start(self) -> None:
+        seed = self.next_seed
+        self.obs, info = self.env.reset(seed=seed)
+        self.human.reset(seed)
+        if self.assistant is not None:
+            self.assistant.reset(seed)
+        self.step_count, self.interventions = 0, 0
+        slot = self.env.world.slots[0]
+        self._writer().start_episode(
+            seed=seed,
+            task=self.env.task.describe(),
+            target=info["target"],
+            initial_state=dict(
+                zip(("lat_deg", "lon_deg", "altitude_ft"), slot.state[:3].tolist(), strict=True)
+            ),
+            source=self.source,
+        )
+        self.state, self.message, self.show_help = "recording", "", False
+
+    def _finish(self, outcome: str) -> None:
+        writer = self._writer()
+        writer.end_episode(outcome=outcome, steps=self.step_count, interventions=self.interventions)
+        self.updater.request()  # the dataset follows in a helper process, off the GIL
+        self.stats.saved += 1
+        self.episode += 1
+        self.next_seed += 1
+        self.state = "idle"
+        self.message = f"episode saved ({outcome}); Space: next episode"
+
+    def _discard(self) -> None:
+        self._writer().discard_episode("discarded by the pilot")
+        self.stats.discarded += 1
+        self.state, self.message = "idle", "episode discarded; Space: fly it again"
+
+    # -- loop ------------------------------------------------------------------------------
+    def _command(self, command: str) -> bool:
+        """Apply a session command; False to quit."""
+        if command == "quit":
+            if self.state in ("recording", "paused"):
+                self._discard()
+            return False
+        if command == "help":
+            self.show_help = not self.show_help
+        elif command == "start" and self.state == "idle":
+            self._start()
+        elif command == "end" and self.state in ("recording", "paused"):
+            self._finish("ended by the pilot")
+        elif command == "discard" and self.state in ("recording", "paused"):
+            self._discard()
+        elif command == "pause" and self.state in ("recording", "paused"):
+            self.state = "paused" if self.state == "recording" else "recording"
+        elif command == "takeover" and self.assistant is not None:
+            self.human_flies = not self.human_flies
+            if self.human_flies:  # start from where the assistant had the controls
+                self.human.values[:] = self.last_action
+        return True
+
+    def _step(self) -> None:
+        obs = self.obs
+        if self.human_flies:
+            action = self.human.act(obs)
+            if self.assistant is not None and hasattr(self.assistant, "track"):
+                self.assistant.act(obs)
+                self.assistant.track(action)  # bumpless hand-back
+        else:
+            action = np.clip(self.assistant.act(obs), [-1, -1, -1, 0], 1)  # type: ignore[union-attr]
+        self.last_action = action
+        self.obs, reward, terminated, truncated, info = self.env.step(action)
+        self.step_count += 1
+        intervention = self.assistant is not None and self.human_flies
+        self.interventions += int(intervention)
+        self._writer().log_step(
+            "ego",
+            self.step_count,
+            self.env.world.slots[0].state,
+            obs,
+            action,
+            action,
+            reward,
+            terminated,
+            truncated,
+            intervention,
+        )
+        if terminated or truncated:
+            self._finish(info.get("reason", "terminated") if terminated else "time limit")
+
+    def _draw(self) -> None:
+        env = self.env
+        slot = env.world.slots[0]
+        state = slot.state
+        names = env.observation_names
+        target = actual = None
+        target_name = ""
+        if names[-2].endswith("_target") and self.state != "idle":
+            var = names[-2].removesuffix("_target")
+            target_name = f"{var} ({BY_NAME[var].unit})"
+            target = env.task.target_value(env.world.steps)
+            actual = float(state[INDEX[var]])
+        left = (
+            max(0.0, (env.world.max_steps - env.world.steps) * env.dt)
+            if self.state != "idle"
+            else env.world.max_steps * env.dt
+        )
+        pilot = "human" if self.human_flies else str(self.assist_name)
+        frame = GuiFrame(
+            action=self.human.values
+            if self.human_flies or self.state == "idle"
+            else getattr(self, "last_action", self.human.values),
+            variables={n: (float(state[INDEX[n]]), BY_NAME[n].unit) for n in SHOWN},
+            target_name=target_name,
+            target=target,
+            actual=actual,
+            episode=self.episode,
+            time_left_s=left,
+            status=self.state,
+            pilot=pilot,
+            message=self.message or self.human.status,
+            help_lines=self.help,
+            show_help=self.show_help,
+        )
+        self.gui.draw(frame)
+
+    def run(self, max_frames: int | None = None) -> SessionStats:
+        import pygame
+
+        period = self.env.dt
+        frame = 0
+        next_deadline = time.perf_counter()
+        last_start: float | None = None
+        running = True
+        try:
+            while running and (max_frames is None or frame < max_frames):
+                start = time.perf_counter()
+                if last_start is not None:
+                    self.stats.periods.append(start - last_start)
+                last_start = start
+                if self.on_frame is not None:
+                    self.on_frame(frame, self)
+                events = pygame.event.get()
+                commands = self.human.handle(events, period)
+                for ev in events:
+                    if ev.type == pygame.QUIT:
+                        commands.append("quit")
+                    elif ev.type == pygame.KEYDOWN:
+                        cmd = COMMAND_KEYS.get(pygame.key.name(ev.key))
+                        if cmd:
+                            commands.append(cmd)
+                for command in commands:
+                    running = self._command(command) and running
+                if running and self.state == "recording":
+                    self._step()
+                self.updater.poll()
+                self._draw()
+                frame += 1
+                self.stats.frames = frame
+                if self.max_episodes and self.stats.saved >= self.max_episodes:
+                    break
+                if self.realtime:
+                    next_deadline += period
+                    now = time.perf_counter()
+                    if next_deadline < now - period:  # far behind: no catch-up burst
+                        next_deadline = now
+                    _sleep_until(next_deadline)
+        finally:
+            self.close()
+        return self.stats
+
+    def close(self) -> None:
+        if self.writer is not None:
+            self.writer.close()
+            self.writer = None
+        self.env.close()
+        self.gui.close()
+        if self.updater.close():
+            self.stats.dataset = self.out / DATASET
+
+
+class DatasetUpdater:
+    """Brings ``out/dataset`` up to date with ``out/logs`` in a helper process (``collect
+    recover``), one run at a time; a request made while a run is going starts another after.
+
+    Building in-process would import LeRobot (seconds of GIL) and stall the real-time loop.
+    """
+
+    def __init__(self, out: Path) -> None:
+        self.out = out
+        self.proc: subprocess.Popen[bytes] | None = None
+        self.pending = False
+        self.failures = 0
+
+    def _launch(self) -> None:
+        cmd = [sys.executable, "-m", "gymfg_il.collect", "recover", str(self.out)]
+        self.proc = subprocess.Popen(
+            cmd,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            env={**os.environ, "HF_HUB_OFFLINE": "1"},
+        )
+        self.pending = False
+
+    def request(self) -> None:
+        if self.proc is None:
+            self._launch()
+        else:
+            self.pending = True
+
+    def poll(self) -> None:
+        if self.proc is not None and self.proc.poll() is not None:
+            self.failures += self.proc.returncode != 0
+            self.proc = None
+            if self.pending:
+                self._launch()
+
+    def close(self) -> bool:
+        """Finish outstanding work; True if a dataset was built."""
+        built = False
+        while self.proc is not None or self.pending:
+            if self.proc is None:
+                self._launch()
+            assert self.proc is not None
+            _, err = self.proc.communicate()
+            if self.proc.returncode != 0:
+                self.failures += 1
+                log.error(
+                    "updating the dataset failed (the logs keep everything; run "
+                    "`python -m gymfg_il.collect recover %s`): %s",
+                    self.out,
+                    err.decode(errors="replace")[-2000:],
+                )
+            else:
+                built = True
+            self.proc = None
+        return built
+
+
+def _sleep_until(deadline: float) -> None:
+    """Sleep coarsely, then spin the last millisecond (sleep alone overshoots by ~0.1-1 ms)."""
+    remaining = deadline - time.perf_counter()
+    if remaining > 0.0015:
+        time.sleep(remaining - 0.001)
+    while time.perf_counter() < deadline:
+        pass

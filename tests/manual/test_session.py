@@ -1,0 +1,141 @@
+"""The manual collector driven headless by injected pygame events, for all three devices."""
+
+import os
+
+import numpy as np
+import pytest
+
+os.environ["SDL_VIDEODRIVER"] = "dummy"
+import pygame
+
+from gymfg_il.errors import ConfigError
+from gymfg_il.learning.data import load_frames
+from gymfg_il.manual.session import ManualSession
+from gymfg_il.parallel import EnvSpec
+
+SPEC = EnvSpec("altitude", "c172p", episode_time_s=3, agent_hz=30)  # 90 frames an episode
+
+
+def key(k, down=True):
+    kind = pygame.KEYDOWN if down else pygame.KEYUP
+    pygame.event.post(pygame.event.Event(kind, key=k, mod=0, unicode="", scancode=0))
+
+
+def run(out, script, **kwargs):
+    def on_frame(frame, session):
+        for event in script.get(frame, []):
+            event() if callable(event) else pygame.event.post(event)
+
+    session = ManualSession(SPEC, out, realtime=False, on_frame=on_frame, **kwargs)
+    return session.run(max_frames=kwargs.pop("frames", 400))
+
+
+def test_keyboard_rates_and_centring_reach_the_dataset(tmp_path):
+    script = {
+        1: [lambda: key(pygame.K_SPACE)],
+        3: [lambda: key(pygame.K_LEFT)],
+        13: [lambda: key(pygame.K_LEFT, False)],
+        40: [lambda: key(pygame.K_PAGEUP)],
+        46: [lambda: key(pygame.K_PAGEUP, False)],
+        200: [lambda: key(pygame.K_q)],
+    }
+    stats = run(tmp_path, script)
+    assert stats.saved == 1
+    frames = load_frames(tmp_path / "dataset")
+    aileron, throttle = frames.action[:, 0], frames.action[:, 3]
+    assert len(aileron) == 90
+    # session frame k flies dataset frame k - 1 (Space at frame 1 starts and flies frame 0);
+    # left held for session frames 3..12 at 1.5/s: -0.05 per frame
+    assert aileron[1] == 0.0 and aileron[2] == pytest.approx(-0.05)
+    assert aileron[11] == pytest.approx(-0.5, abs=1e-6)
+    # released: back to centre at 1/s (1/30 per frame) -> zero 15 frames later
+    assert aileron[12] == pytest.approx(-0.5 + 1 / 30, abs=1e-6)
+    assert aileron[30] == 0.0
+    # throttle up for 6 frames at 0.5/s from the c172p's cruise 0.75
+    assert throttle[45] == pytest.approx(0.75 + 6 * 0.5 / 30, abs=1e-6)
+    assert not frames.episodes["gymfg/interventions"][0]
+    assert frames.episodes["gymfg/source"] == ["human"]
+
+
+def test_mouse_is_the_stick(tmp_path):
+    move = pygame.event.Event(
+        pygame.MOUSEMOTION, pos=(450 + 100, 300 - 50), rel=(0, 0), buttons=(0, 0, 0)
+    )
+    script = {1: [lambda: key(pygame.K_SPACE)], 5: [move], 200: [lambda: key(pygame.K_q)]}
+    run(tmp_path, script, device="mouse")
+    frames = load_frames(tmp_path / "dataset")
+    # 100 px right of centre, 50 px up, span 200 px: aileron 0.5, elevator +0.25 (nose down)
+    assert frames.action[4, 0] == pytest.approx(0.5) and frames.action[4, 1] == pytest.approx(0.25)
+    assert frames.action[2, 0] == 0.0
+
+
+def test_joystick_axes_buttons_and_unplugging(tmp_path):
+    added = pygame.event.Event(pygame.JOYDEVICEADDED, device_index=0, instance_id=0)
+    axis = pygame.event.Event(pygame.JOYAXISMOTION, instance_id=0, axis=0, value=0.6)
+    pitch = pygame.event.Event(pygame.JOYAXISMOTION, instance_id=0, axis=1, value=0.02)
+    removed = pygame.event.Event(pygame.JOYDEVICEREMOVED, instance_id=0)
+    button_end = pygame.event.Event(pygame.JOYBUTTONDOWN, instance_id=0, button=2)
+    script = {
+        0: [added],
+        1: [lambda: key(pygame.K_SPACE)],
+        5: [axis, pitch],
+        30: [removed],
+        40: [added, axis],
+        60: [button_end],
+        200: [lambda: key(pygame.K_q)],
+    }
+    bindings = {"joystick": {"buttons": {2: "end"}}}
+    stats = run(tmp_path, script, device="joystick", bindings=bindings)
+    assert stats.saved == 1
+    frames = load_frames(tmp_path / "dataset")
+    a = frames.action
+    shaped = ((0.6 - 0.05) / 0.95) * 0.7 + 0.3 * ((0.6 - 0.05) / 0.95) ** 3
+    assert a[4, 0] == pytest.approx(shaped, rel=1e-6)
+    assert a[4, 1] == 0.0  # inside the dead zone
+    assert a[29, 0] == 0.0  # unplugged: centred, and the session went on
+    assert a[39, 0] == pytest.approx(shaped, rel=1e-6)  # plugged back in
+    assert len(a) == 59  # the button ended and saved the episode
+
+
+def test_takeover_from_the_controller_is_flagged_and_handed_back(tmp_path):
+    script = {
+        1: [lambda: key(pygame.K_SPACE)],
+        20: [lambda: key(pygame.K_t)],
+        21: [lambda: key(pygame.K_UP)],
+        30: [lambda: key(pygame.K_UP, False)],
+        40: [lambda: key(pygame.K_t)],
+        200: [lambda: key(pygame.K_q)],
+    }
+    run(tmp_path, script, assist="controller")
+    frames = load_frames(tmp_path / "dataset")
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    ds = LeRobotDataset("x/y", root=tmp_path / "dataset", video_backend="pyav")
+    intervention = np.array([bool(ds[i]["intervention"]) for i in range(len(ds))])
+    assert intervention[:19].sum() == 0 and intervention[19:39].all()
+    assert intervention[39:].sum() == 0
+    assert frames.episodes["gymfg/interventions"] == [20]
+    assert frames.episodes["gymfg/source"] == ["controller+human"]
+    # the human pushed the nose down while flying; the controller's hand-back is bumpless
+    assert frames.action[25, 1] > frames.action[18, 1]
+    assert abs(frames.action[39, 1] - frames.action[38, 1]) < 0.1
+
+
+def test_discarded_episode_is_flown_again_with_its_seed(tmp_path):
+    script = {
+        1: [lambda: key(pygame.K_SPACE)],
+        10: [lambda: key(pygame.K_BACKSPACE)],
+        12: [lambda: key(pygame.K_SPACE)],
+        300: [lambda: key(pygame.K_q)],
+    }
+    stats = run(tmp_path, script, seed=7)
+    assert (stats.saved, stats.discarded) == (1, 1)
+    frames = load_frames(tmp_path / "dataset")
+    assert frames.episodes["gymfg/seed"] == [7] and len(frames) == 90
+
+
+def test_appending_another_task_is_refused(tmp_path):
+    run(tmp_path, {1: [lambda: key(pygame.K_SPACE)], 200: [lambda: key(pygame.K_q)]})
+    roll = EnvSpec("roll", "c172p", episode_time_s=3, agent_hz=30)
+    with pytest.raises(ConfigError, match="features differ"):
+        ManualSession(roll, tmp_path, realtime=False)
