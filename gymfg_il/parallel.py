@@ -8,6 +8,7 @@ and agents from picklable specs (``EnvSpec``, ``AgentSpec``).
 from __future__ import annotations
 
 import multiprocessing as mp
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -83,6 +84,20 @@ def _worker_init() -> None:
         sys.modules["torch"].set_num_threads(1)
 
 
+def _start_method() -> str:
+    """fork when it is safe (workers then start in milliseconds with everything imported);
+    forkserver when this process runs other threads (forking them can deadlock); spawn where
+    neither exists."""
+    methods = mp.get_all_start_methods()
+    if "fork" in methods and threading.active_count() == 1:
+        return "fork"
+    if "forkserver" in methods:
+        mp.set_forkserver_preload(["gymfg_il.parallel", "gymfg_il.evaluation.parallel",
+                                   "gymfg_il.collectors.session"])
+        return "forkserver"
+    return "spawn"
+
+
 def _call[T](job: tuple[Callable[..., T], tuple[Any, ...]]) -> T:
     fn, args = job
     return fn(*args)
@@ -99,10 +114,7 @@ def map_seeds[T](
         for seed in seeds:
             yield fn(*args, seed)
         return
-    # fork: workers start in milliseconds with everything imported (the parent has run no
-    # torch kernels, so no thread pool is forked); spawn elsewhere.
-    method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
-    ctx = mp.get_context(method)
+    ctx = mp.get_context(_start_method())
     with ctx.Pool(min(workers, len(seeds)), initializer=_worker_init) as pool:
         jobs = [(fn, (*args, seed)) for seed in seeds]
         chunk = max(1, len(seeds) // (4 * workers))
