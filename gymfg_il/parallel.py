@@ -92,8 +92,9 @@ def _start_method() -> str:
     if "fork" in methods and threading.active_count() == 1:
         return "fork"
     if "forkserver" in methods:
-        mp.set_forkserver_preload(["gymfg_il.parallel", "gymfg_il.evaluation.parallel",
-                                   "gymfg_il.collectors.session"])
+        mp.set_forkserver_preload(
+            ["gymfg_il.parallel", "gymfg_il.evaluation.parallel", "gymfg_il.collectors.session"]
+        )
         return "forkserver"
     return "spawn"
 

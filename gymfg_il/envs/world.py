@@ -8,6 +8,7 @@ clock; it knows nothing about who chooses the actions.
 from __future__ import annotations
 
 import math
+import zlib
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -142,7 +143,15 @@ class Slot:
 class World:
     """All aircraft of all teams, stepped together at ``config.agent_hz``."""
 
-    def __init__(self, teams: Sequence[Team], config: EnvConfig, pool: SimPool | None = None):
+    def __init__(
+        self,
+        teams: Sequence[Team],
+        config: EnvConfig,
+        pool: SimPool | None = None,
+        external_targets: bool = False,
+    ):
+        """``external_targets``: reward targets outside these teams are allowed (an online
+        env); they are seen through ``external[callsign]``, filled from the central state."""
         if not teams:
             raise ConfigError("a simulation needs at least one Team")
         check_unique(teams)
@@ -161,6 +170,8 @@ class World:
                 self.slots.append(Slot(len(self.slots), team.name, aircraft, task, sim))
         self.by_callsign = {s.callsign: s for s in self.slots}
         self.team_slots = {t.name: [s for s in self.slots if s.team == t.name] for t in teams}
+        self.external: dict[str, StateView] = {}
+        self._external_targets = external_targets
         self._link_reward_targets()
         self.steps = 0
         self.started = False
@@ -172,6 +183,12 @@ class World:
                 slot = self.by_callsign[owner.callsign]
                 for target in targets:
                     source = self.by_callsign.get(target.callsign)
+                    if source is None and self._external_targets:
+                        view = self.external.setdefault(
+                            target.callsign, StateView(np.full(len(view_names), np.nan), view_names)
+                        )
+                        slot.ctx.targets[target.callsign] = view
+                        continue
                     if source is None or source.aircraft.model != target.model:
                         raise ConfigError(
                             f"team {team.name!r}: {owner.callsign!r} takes reward target "
@@ -192,20 +209,29 @@ class World:
         rng: np.random.Generator,
         overrides: Mapping[str, InitialConditions] | None = None,
     ) -> None:
-        """Start an episode: joint (scenario), overridden or per-task initial conditions."""
+        """Start an episode: joint (scenario), overridden or per-task initial conditions.
+
+        Each aircraft draws from its own stream, derived from one number drawn from ``rng``
+        and its callsign, so an aircraft's start and targets do not depend on which other
+        aircraft share the simulation (an online team, which simulates only itself, meets
+        the same episode as in the offline env).
+        """
+        base = int(rng.integers(2**63))
         scenario = self.config.scenario
         ics: dict[str, InitialConditions] = {}
         if scenario is not None:
-            ics.update(scenario(rng, [(s.team, s.aircraft) for s in self.slots]))
+            joint = np.random.default_rng([base, 0])
+            ics.update(scenario(joint, [(s.team, s.aircraft) for s in self.slots]))
         ics.update(overrides or {})
         unknown = set(ics) - set(self.by_callsign)
         if unknown:
             raise ConfigError(f"initial conditions given for unknown callsigns {sorted(unknown)}")
         for slot in self.slots:
-            ic = ics.get(slot.callsign) or slot.task.initial_conditions(rng)
+            own = np.random.default_rng([base, 1 + zlib.crc32(slot.callsign.encode())])
+            ic = ics.get(slot.callsign) or slot.task.initial_conditions(own)
             throttle = slot.aircraft.profile.cruise_throttle
             slot.state = slot.prev_state = slot.sim.reset(ic, throttle)
-            slot.task.reset(slot.state, rng)
+            slot.task.reset(slot.state, own)
             slot.action = slot.prev_action = np.array([0.0, 0.0, 0.0, throttle])
             slot.reward = 0.0
             slot.terminated = False
@@ -216,6 +242,12 @@ class World:
 
     def advance(self, actions: Sequence[Controls | None]) -> None:
         """Apply one action per slot (None for terminated aircraft), step, score, check ends."""
+        self.step_physics(actions)
+        self.score()
+
+    def step_physics(self, actions: Sequence[Controls | None]) -> None:
+        """Apply one action per slot and advance JSBSim; ``score`` follows (an online env
+        first learns the other teams' states in between)."""
         slots = self.slots
         for slot, act in zip(slots, actions, strict=True):
             if slot.terminated or act is None:
@@ -228,7 +260,10 @@ class World:
             slot.prev_action = slot.action
             slot.action = np.array(act)
         self.steps += 1
-        for slot in slots:
+
+    def score(self) -> None:
+        """Rewards and terminations of the step just taken."""
+        for slot in self.slots:
             if slot.terminated:
                 slot.reward = 0.0
                 continue

@@ -230,7 +230,9 @@ def test_formation_scenario_places_aircraft_jointly():
     lead, wing, slot = (StateView(v.state) for v in views)
     assert geometry.distance_ft(lead, wing) == pytest.approx(300 * 2**0.5, abs=60)
     assert geometry.distance_ft(lead, slot) == pytest.approx(600 * 2**0.5, abs=60)
-    assert wing.heading_deg == pytest.approx(lead.heading_deg, abs=1e-3)
+    from gymfg_il.tasks.orientation import angle_difference_deg
+
+    assert angle_difference_deg(wing.heading_deg, lead.heading_deg) == pytest.approx(0, abs=1e-3)
     env.reset(seed=4)
     assert geometry.distance_ft(
         StateView(views[0].state), StateView(views[1].state)

@@ -1,0 +1,1 @@
+"""Online environments: a central state server and clients that each simulate one team."""

@@ -1,0 +1,193 @@
+"""The online client env: the same API as ``OfflineEnv``, with the other teams on a central
+state server. The team's aircraft are simulated here (JSBSim stays local to the team); their
+states are reported every step and the server answers with what the team may see of the
+others.
+
+    env = OnlineEnv("tcp://127.0.0.1:5555", token="secret")
+    team_state, opponent_states = env.reset(team, seed=0)
+    ... env.step(np.hstack(actions)) ...   # exactly the paper's loop
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.envs.actions import team_controls
+from gymfg_il.envs.team import Team
+from gymfg_il.envs.world import EnvConfig, SimPool, World
+from gymfg_il.errors import EnvStateError
+from gymfg_il.online.protocol import ProtocolError, ServerError, decode, encode
+
+
+class OnlineEnv:
+    """A team's end of an online simulation.
+
+    Args:
+        address: the server (``tcp://host:port``).
+        token: the team's secret (per-team or shared), if the server asks for one.
+        server_key: the server's CURVE public key, when it encrypts.
+        timeout_s: how long to wait for the server before giving up (a ``wait`` message from
+            a paused server restarts the clock).
+        sim_hz, agent_hz: rates, as in ``OfflineEnv``.
+
+    ``reset`` and ``step`` return what ``OfflineEnv`` returns; ``truncated`` also becomes True
+    when the server ends the simulation (in a k-fixed simulation, when any team completes),
+    with ``info["server_reason"]``.
+    """
+
+    def __init__(
+        self,
+        address: str,
+        *,
+        token: str = "",
+        server_key: bytes | None = None,
+        timeout_s: float = 10.0,
+        sim_hz: int = 120,
+        agent_hz: int = 10,
+    ) -> None:
+        import zmq
+
+        self.address, self.token, self.timeout_s = address, token, timeout_s
+        self.config = EnvConfig(sim_hz, agent_hz)
+        self._pool = SimPool(sim_hz, agent_hz)
+        self.ctx: Any = zmq.Context.instance()
+        self.sock = self.ctx.socket(zmq.DEALER)
+        self.sock.setsockopt(zmq.LINGER, 0)
+        if server_key is not None:
+            public, secret = zmq.curve_keypair()
+            self.sock.curve_publickey, self.sock.curve_secretkey = public, secret
+            self.sock.curve_serverkey = server_key
+        self.sock.connect(address)
+        self.world: World | None = None
+        self.team: Team | None = None
+        self.view: tuple[str, ...] = ()
+        self.joined = False
+        self._rng = np.random.default_rng()
+        self._done = True
+        self.opponents: list[str] = []
+
+    @property
+    def dt(self) -> float:
+        return self.config.dt
+
+    # -- wire ----------------------------------------------------------------------------
+    def _request(self, msg: dict[str, Any], expect: str) -> dict[str, Any]:
+        self.sock.send(encode({**msg, "team": self.team.name, "token": self.token}))  # type: ignore[union-attr]
+        while True:
+            if not self.sock.poll(int(self.timeout_s * 1000)):
+                raise ServerError(
+                    "timeout",
+                    f"no answer from {self.address} within "
+                    f"{self.timeout_s:g} s; is the server running?",
+                )
+            try:
+                reply = decode(self.sock.recv(), "server")
+            except ProtocolError as err:
+                raise ServerError("malformed", f"the server sent a bad message: {err}") from None
+            if reply["type"] == "error":
+                raise ServerError(reply.get("code", "error"), reply.get("message", ""))
+            if reply["type"] == "wait":
+                continue  # a paused simulation: keep waiting
+            if reply["type"] == expect:
+                return reply
+
+    def _report(self, done: bool) -> dict[str, Any]:
+        assert self.world is not None
+        states = {s.callsign: s.state.tolist() for s in self.world.slots}
+        return self._request({"type": "report", "states": states, "done": done}, "central")
+
+    def _opponents(self, central: dict[str, Any]) -> np.ndarray:
+        rows = central["opponents"]
+        self.opponents = [r[0] for r in rows]
+        assert self.world is not None
+        for callsign, _, values in rows:
+            view = self.world.external.get(callsign)
+            if view is not None:
+                view.values = np.asarray(values, dtype=np.float64)
+        if not rows:
+            return np.zeros((0, len(self.view)))
+        return np.array([r[2] for r in rows], dtype=np.float64)
+
+    # -- API -----------------------------------------------------------------------------
+    def reset(
+        self,
+        team: Team | None = None,
+        *,
+        seed: int | None = None,
+        options: Mapping[str, Any] | None = None,
+    ) -> tuple[list[np.ndarray], np.ndarray]:
+        if team is not None and team is not self.team:
+            if self.world is not None:
+                self.world.close()
+            self.team = team
+            self.world = World([team], self.config, self._pool, external_targets=True)
+            self.joined = False
+        if self.world is None or self.team is None:
+            raise EnvStateError("the first reset needs your team: env.reset(team)")
+        if not self.joined:
+            welcome = self._request(
+                {"type": "join", "aircraft": {a.callsign: a.model for a in self.team.aircraft}},
+                "welcome",
+            )
+            self.view = tuple(welcome["opponent_view"])
+            self.joined = True
+        if seed is not None:
+            self._rng = np.random.default_rng(seed)
+        overrides = dict((options or {}).get("initial_conditions", {}))
+        self.world.reset(self._rng, overrides)
+        central = self._report(done=False)
+        self._done = False
+        opponents = self._opponents(central)
+        return [self.world.observation(s) for s in self.world.slots], opponents
+
+    def step(
+        self, team_actions: object
+    ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray, bool, bool, dict[str, Any]]:
+        world, team = self.world, self.team
+        if world is None or team is None or self._done:
+            raise EnvStateError("call env.reset(team) before step (and again after the end)")
+        world.step_physics(team_controls(team_actions, team.callsigns))
+        terminated_now = all(s.terminated for s in world.slots)
+        central = self._report(done=world.truncated)
+        opponents = self._opponents(central)
+        world.score()
+        slots = world.slots
+        terminated = all(s.terminated for s in slots) or terminated_now
+        truncated = (world.truncated or bool(central["done"])) and not terminated
+        self._done = terminated or truncated
+        info = {
+            "step": world.steps,
+            "time_s": world.steps * world.dt,
+            "tick": central["tick"],
+            "terminated": [s.terminated for s in slots],
+            "reasons": {s.callsign: s.reason for s in slots if s.reason},
+            "opponent_callsigns": list(self.opponents),
+            "server_reason": central.get("reason", ""),
+        }
+        rewards = np.array([s.reward for s in slots])
+        return (
+            [world.observation(s) for s in slots],
+            opponents,
+            rewards,
+            terminated,
+            truncated,
+            info,
+        )
+
+    def leave(self) -> None:
+        if self.joined and self.team is not None:
+            self.sock.send(encode({"type": "leave", "team": self.team.name, "token": self.token}))
+            self.joined = False
+
+    def close(self) -> None:
+        try:
+            self.leave()
+        finally:
+            self.sock.close(0)
+            if self.world is not None:
+                self.world.close()
+                self.world = None
+            self._pool.close()

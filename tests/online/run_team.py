@@ -1,0 +1,66 @@
+"""A team's client process for the online tests: flies the paper's loop against a server and
+saves its states per step (``python run_team.py ADDRESS TOKEN TEAM SEED SECONDS OUT``)."""
+
+import sys
+
+import numpy as np
+
+from gymfg_il import Team
+from gymfg_il.aircraft import c172p, f15
+from gymfg_il.controllers.autopilot import controller_for
+from gymfg_il.tasks import (
+    ReachStaticTargetAltitudeTask,
+    ReachStaticTargetHeadingTask,
+    ReachStaticTargetRollTask,
+)
+
+
+def teams(seconds: float) -> dict[str, Team]:
+    return {
+        "red": Team(
+            "red",
+            [
+                (c172p("red-1"), ReachStaticTargetAltitudeTask),
+                (c172p("red-2"), ReachStaticTargetRollTask),
+            ],
+            episode_time_s=seconds,
+        ),
+        "blue": Team(
+            "blue", [(f15("blue-1"), ReachStaticTargetHeadingTask)], episode_time_s=seconds
+        ),
+    }
+
+
+def pilots(env, team):
+    return [
+        controller_for(s.task, s.aircraft.model, env.dt, s.aircraft.profile.cruise_throttle)
+        for s in env.world.team_slots[team.name]
+    ]
+
+
+def fly(env, team, seed, on_step=None):
+    team_state, opponents = env.reset(team, seed=seed)
+    agents = pilots(env, team)
+    for agent in agents:
+        agent.reset(seed)
+    states, done, info = [], False, {}
+    while not done:
+        actions = [a.act(s, opponents) for s, a in zip(team_state, agents, strict=True)]
+        team_state, opponents, _, terminated, truncated, info = env.step(np.hstack(actions))
+        states.append(np.stack([s.state for s in env.world.team_slots[team.name]]))
+        done = terminated or truncated
+        if on_step is not None:
+            on_step(len(states))
+    return np.array(states), info
+
+
+if __name__ == "__main__":
+    from gymfg_il.online.client import OnlineEnv
+
+    address, token, name, seed, seconds, out = sys.argv[1:7]
+    team = teams(float(seconds))[name]
+    env = OnlineEnv(address, token=token, timeout_s=20)
+    states, info = fly(env, team, int(seed), lambda n: print(f"step {n}", flush=True))
+    np.save(out, states)
+    print(f"done {len(states)} {info['server_reason']}", flush=True)
+    env.close()

@@ -1,0 +1,252 @@
+"""Real server and client processes on loopback."""
+
+import os
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import zmq
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from gymfg_il.online.client import OnlineEnv
+from gymfg_il.online.protocol import ServerError, decode, encode
+
+pytestmark = pytest.mark.network
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+import run_team  # noqa: E402
+
+ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def server(request):
+    """Start ``python -m gymfg_il.serve`` with the test's options; yields its address."""
+    procs = []
+
+    def start(*options):
+        port = free_port()
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "gymfg_il.serve", "--port", str(port), *options],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            env=ENV,
+        )
+        procs.append(proc)
+        assert b"serving" in proc.stdout.readline()
+        return f"tcp://127.0.0.1:{port}", proc
+
+    yield start
+    for proc in procs:
+        proc.terminate()
+        proc.wait(5)
+
+
+def client(address, token, team, seed, seconds, out):
+    return subprocess.Popen(
+        [
+            sys.executable,
+            str(HERE / "run_team.py"),
+            address,
+            token,
+            team,
+            str(seed),
+            str(seconds),
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        env=ENV,
+    )
+
+
+def test_online_run_matches_the_offline_env_bit_for_bit(server, tmp_path):
+    address, _ = server("--mode", "fixed", "--teams", "2", "--secret", "s")
+    red = client(address, "s", "red", 5, 6, tmp_path / "red.npy")
+    blue = client(address, "s", "blue", 5, 6, tmp_path / "blue.npy")
+    for proc in (red, blue):
+        out = proc.communicate(timeout=60)[0].decode()
+        assert proc.returncode == 0, out
+    online_red, online_blue = np.load(tmp_path / "red.npy"), np.load(tmp_path / "blue.npy")
+
+    teams = run_team.teams(6)
+    blue_states = []
+    # the same two teams in one offline simulation, seeded alike
+    from gymfg_il.envs.world import EnvConfig, World
+
+    world = World([teams["red"], teams["blue"]], EnvConfig())
+    world.reset(np.random.default_rng(5))
+    agents = {
+        s.callsign: run_team.controller_for(
+            s.task, s.aircraft.model, world.dt, s.aircraft.profile.cruise_throttle
+        )
+        for s in world.slots
+    }
+    red_states = []
+    for _ in range(60):
+        actions = [
+            tuple(np.clip(agents[s.callsign].act(world.observation(s)), [-1, -1, -1, 0], 1))
+            for s in world.slots
+        ]
+        world.advance(actions)
+        red_states.append(np.stack([s.state for s in world.team_slots["red"]]))
+        blue_states.append(np.stack([s.state for s in world.team_slots["blue"]]))
+    world.close()
+    assert online_red.shape == (60, 2, len(red_states[0][0]))
+    assert np.array_equal(online_red, np.array(red_states))
+    assert np.array_equal(online_blue, np.array(blue_states))
+
+
+def test_the_k_plus_first_team_is_refused(server):
+    address, _ = server("--mode", "fixed", "--teams", "1")
+    teams = run_team.teams(3)
+    first = OnlineEnv(address)
+    first.reset(teams["red"], seed=0)  # k = 1: the simulation has its team
+    second = OnlineEnv(address, timeout_s=5)
+    with pytest.raises(ServerError, match="full"):
+        second.reset(teams["blue"], seed=0)
+    first.close()
+    second.close()
+
+
+def test_a_killed_client_neither_hangs_nor_crashes_the_others_and_can_rejoin(server, tmp_path):
+    address, srv = server(
+        "--mode", "fixed", "--teams", "2", "--secret", "s", "--timeout", "1", "--on-stall", "drop"
+    )
+    red = client(address, "s", "red", 1, 300, tmp_path / "red.npy")
+    blue = client(address, "s", "blue", 1, 300, tmp_path / "blue.npy")
+    while b"step 20" not in blue.stdout.readline():
+        pass
+    blue.kill()
+    blue.wait()
+    time.sleep(1.5)  # dropped after its 1 s timeout; red goes on alone
+    again = client(address, "s", "blue", 1, 300, tmp_path / "blue2.npy")
+    out_red = red.communicate(timeout=60)[0].decode()
+    out_blue = again.communicate(timeout=60)[0].decode()
+    assert red.returncode == 0 and "done 3000" in out_red, out_red
+    assert again.returncode == 0 and "team red completed" in out_blue, out_blue
+    assert srv.poll() is None  # the server is still serving
+
+
+def test_wrong_token_and_foreign_aircraft_are_refused(server):
+    address, _ = server("--mode", "open", "--team", "red:r3d", "--team", "blue:blu3")
+    teams = run_team.teams(3)
+    with pytest.raises(ServerError, match="unauthorised"):
+        OnlineEnv(address, token="guess", timeout_s=5).reset(teams["red"], seed=0)
+    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock.connect(address)
+    sock.send(
+        encode({"type": "join", "team": "red", "token": "r3d", "aircraft": {"red-1": "c172p"}})
+    )
+    assert decode(sock.recv(), "server")["type"] == "welcome"
+    state = [0.0] * 26
+    sock.send(
+        encode(
+            {
+                "type": "report",
+                "team": "red",
+                "token": "r3d",
+                "states": {"blue-1": state},
+                "done": False,
+            }
+        )
+    )
+    reply = decode(sock.recv(), "server")
+    assert reply["type"] == "error" and reply["code"] == "forbidden"
+    sock.close(0)
+
+
+def test_a_team_receives_only_the_opponent_view(server):
+    address, _ = server("--mode", "open", "--view", "altitude_ft", "heading_deg")
+    ctx = zmq.Context.instance()
+    socks = {}
+    for team, callsign in (("red", "red-1"), ("blue", "blue-1")):
+        socks[team] = ctx.socket(zmq.DEALER)
+        socks[team].connect(address)
+        socks[team].send(encode({"type": "join", "team": team, "aircraft": {callsign: "c172p"}}))
+        assert decode(socks[team].recv(), "server")["type"] == "welcome"
+    secret = [float(i) for i in range(26)]  # every variable distinct
+    socks["blue"].send(encode({"type": "report", "team": "blue", "states": {"blue-1": [0.0] * 26}}))
+    decode(socks["blue"].recv(), "server")  # blue alone: tick 0
+    socks["red"].send(encode({"type": "report", "team": "red", "states": {"red-1": secret}}))
+    time.sleep(0.3)  # red joins the lockstep before blue's next report
+    socks["blue"].send(encode({"type": "report", "team": "blue", "states": {"blue-1": [0.0] * 26}}))
+    central = decode(socks["blue"].recv(), "server")
+    assert central["type"] == "central"
+    assert central["opponents"] == [["red-1", "red", [2.0, 6.0]]]  # altitude, heading only
+    for s in socks.values():
+        s.close(0)
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck))
+@given(
+    payload=st.one_of(
+        st.binary(max_size=300),
+        st.recursive(
+            st.one_of(
+                st.none(), st.booleans(), st.integers(-(2**63), 2**64 - 1), st.floats(), st.text()
+            ),
+            lambda inner: (
+                st.lists(inner, max_size=4)
+                | st.dictionaries(st.text(max_size=8), inner, max_size=4)
+            ),
+            max_leaves=12,
+        ),
+        st.fixed_dictionaries(
+            {
+                "v": st.just(1),
+                "type": st.sampled_from(["join", "report", "leave"]),
+                "team": st.text(max_size=70),
+                "states": st.dictionaries(
+                    st.text(max_size=5), st.lists(st.floats(), max_size=27), max_size=3
+                ),
+            }
+        ),
+    )
+)
+def test_fuzzed_messages_never_crash_the_server(fuzz_server, payload):
+    _address, sock = fuzz_server
+    import msgpack
+
+    data = payload if isinstance(payload, bytes) else msgpack.packb(payload, use_bin_type=True)
+    sock.send(data)
+    if sock.poll(2000):
+        reply = decode(sock.recv(), "server")
+        assert reply["type"] in ("error", "welcome", "central")
+
+
+@pytest.fixture(scope="module")
+def fuzz_server():
+    port = free_port()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "gymfg_il.serve", "--mode", "open", "--port", str(port)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        env=ENV,
+    )
+    assert b"serving" in proc.stdout.readline()
+    address = f"tcp://127.0.0.1:{port}"
+    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock.connect(address)
+    yield address, sock
+    sock.close(0)
+    # after all the garbage, a real team still flies
+    teams = run_team.teams(1)
+    env = OnlineEnv(address, timeout_s=10)
+    states, _ = run_team.fly(env, teams["red"], 0)
+    env.close()
+    alive = proc.poll() is None
+    proc.terminate()
+    proc.wait(5)
+    assert alive and len(states) == 10
