@@ -13,6 +13,8 @@ Rows (name, value, unit, target, higher_is_better):
 - train_pipeline_frames_per_s: frames/s our in-memory batches deliver, beside stock
   LeRobotDataset + DataLoader.
 - rollout_workers_2_vs_1: speed-up of seeded evaluation episodes on 2 worker processes.
+- online_{2,8,16}_teams_steps_per_s: simulation steps/s of that many client processes (one
+  c172p each) in lockstep with a real server on loopback.
 - manual_loop_p99_period_error_ms: timing of the real-time manual session (30 Hz, GUI and
   recording on, injected keyboard input).
 
@@ -288,11 +290,83 @@ def manual_loop(seconds: float) -> dict[str, float]:
     }
 
 
+def online_client(address: str, name: str, steps: int) -> None:
+    """One team of one c172p flying ``steps`` lockstep steps; prints its steps/s."""
+    from gymfg_il import Team
+    from gymfg_il.aircraft import c172p
+    from gymfg_il.controllers.autopilot import controller_for
+    from gymfg_il.online.client import OnlineEnv
+    from gymfg_il.tasks import LevelFlightTask
+
+    team = Team(name, [(c172p(f"{name}-1"), LevelFlightTask)], episode_time_s=steps / 10 + 10)
+    env = OnlineEnv(address, timeout_s=60)
+    (obs,), _ = env.reset(team, seed=0)
+    assert env.world is not None
+    slot = env.world.slots[0]
+    pilot = controller_for(slot.task, "c172p", env.dt, 0.75)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        (obs,), *_ = env.step(pilot.act(obs))
+    print(f"RATE {steps / (time.perf_counter() - t0)}", flush=True)
+    env.close()
+
+
+def online(teams: int, steps: int) -> float:
+    """Simulation steps/s of ``teams`` client processes in lockstep with a real server."""
+    import socket
+    import subprocess
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    server = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "gymfg_il.serve",
+            "--mode",
+            "fixed",
+            "--teams",
+            str(teams),
+            "--port",
+            str(port),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        assert server.stdout is not None and b"serving" in server.stdout.readline()
+        address = f"tcp://127.0.0.1:{port}"
+        clients = [
+            subprocess.Popen(
+                [sys.executable, __file__, "--online-client", address, f"team{i}", str(steps)],
+                stdout=subprocess.PIPE,
+            )
+            for i in range(teams)
+        ]
+        rates = []
+        for c in clients:
+            out = c.communicate(timeout=600)[0].decode()
+            rates += [
+                float(line.split()[1]) for line in out.splitlines() if line.startswith("RATE")
+            ]
+        return min(rates)  # lockstep: the simulation runs at its slowest team's pace
+    finally:
+        server.terminate()
+        server.wait(10)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     p.add_argument("--json", type=Path, help="write the rows to this JSON file")
     p.add_argument("--quick", action="store_true", help="fewer, shorter rounds (a smoke run)")
+    p.add_argument(
+        "--online-client", nargs=3, metavar=("ADDRESS", "TEAM", "STEPS"), help=argparse.SUPPRESS
+    )
     args = p.parse_args(argv)
+    if args.online_client:
+        online_client(args.online_client[0], args.online_client[1], int(args.online_client[2]))
+        return 0
     steps, rounds = (200, 2) if args.quick else (900, 7)
     rows: list[dict[str, object]] = []
 
@@ -345,6 +419,22 @@ def main(argv: list[str] | None = None) -> int:
             "higher_is_better": False,
         }
     )
+
+    for teams in (2, 8, 16):
+        rate = online(teams, 300 if args.quick else 2000)
+        target = 2000 if teams == 2 else None
+        note = "(target >= 2,000)" if target else "(reported)"
+        print(f"online_{teams}_teams_steps_per_s {rate:13,.0f} steps/s  {note}")
+        rows.append(
+            {
+                "name": f"online_{teams}_teams_steps_per_s",
+                "value": rate,
+                "unit": "steps/s",
+                "target": target,
+                "higher_is_better": True,
+            }
+        )
+    print()
 
     sample = Path(__file__).resolve().parents[1] / "datasets/sample-altitude-c172p/dataset"
     r = train_pipeline(sample, 1000 if args.quick else 4000)

@@ -56,6 +56,7 @@ class OnlineEnv:
         self.ctx: Any = zmq.Context.instance()
         self.sock = self.ctx.socket(zmq.DEALER)
         self.sock.setsockopt(zmq.LINGER, 0)
+        self.sock.setsockopt(zmq.RCVTIMEO, int(timeout_s * 1000))
         if server_key is not None:
             public, secret = zmq.curve_keypair()
             self.sock.curve_publickey, self.sock.curve_secretkey = public, secret
@@ -76,15 +77,19 @@ class OnlineEnv:
     # -- wire ----------------------------------------------------------------------------
     def _request(self, msg: dict[str, Any], expect: str) -> dict[str, Any]:
         self.sock.send(encode({**msg, "team": self.team.name, "token": self.token}))  # type: ignore[union-attr]
+        import zmq
+
         while True:
-            if not self.sock.poll(int(self.timeout_s * 1000)):
+            try:
+                data = self.sock.recv()  # RCVTIMEO bounds the wait (one syscall, no poll)
+            except zmq.Again:
                 raise ServerError(
                     "timeout",
                     f"no answer from {self.address} within "
                     f"{self.timeout_s:g} s; is the server running?",
-                )
+                ) from None
             try:
-                reply = decode(self.sock.recv(), "server")
+                reply = decode(data, "server")
             except ProtocolError as err:
                 raise ServerError("malformed", f"the server sent a bad message: {err}") from None
             if reply["type"] == "error":

@@ -17,8 +17,6 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from gymfg_il.errors import ConfigError
 from gymfg_il.online.protocol import MAX_MESSAGE_BYTES, ProtocolError, decode, encode
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
@@ -116,6 +114,8 @@ class StateServer:
         else:
             self.port = self.sock.bind_to_random_port(f"tcp://{config.bind}")
         self.view_idx = indices(tuple(config.opponent_view))
+        self._view = self.view_idx.tolist()
+        self._last_stall_check = 0.0
         self.teams: dict[str, TeamRecord] = {}
         self.owner: dict[str, str] = {}  # callsign -> team
         self.tick = 0
@@ -260,9 +260,9 @@ class StateServer:
         end = (bool(done_teams) and self.config.mode == "fixed") or bool(reason)
         if done_teams and not reason:
             reason = f"team {done_teams[0]} completed"
-        view = self.view_idx
+        view = self._view
         rows = {
-            t.name: [[c, t.name, np.asarray(t.states[c])[view].tolist()] for c in t.callsigns]
+            t.name: [[c, t.name, [t.states[c][i] for i in view]] for c in t.callsigns]
             for t in self.teams.values()
             if t.states
         }
@@ -353,7 +353,10 @@ class StateServer:
                     log.warning("dropped a message of %d frames", len(frames))
                     continue
                 self.handle(frames[0], frames[1])
-            self._check_stalls()
+            now = time.monotonic()
+            if now - self._last_stall_check > 0.05:  # not after every message
+                self._last_stall_check = now
+                self._check_stalls()
 
     def stop(self) -> None:
         self._stop = True
