@@ -134,6 +134,14 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         default=Path("datasets/manual"),
         help="session folder (default: datasets/manual)",
     )
+    man.add_argument(
+        "--view",
+        type=int,
+        action="append",
+        default=[],
+        metavar="PORT",
+        help="FlightGear out-the-window view on this UDP port (repeatable)",
+    )
     dag = sub.add_parser(
         "dagger",
         help="the policy flies, the controller labels what it "
@@ -164,6 +172,15 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     )
     rep.add_argument("log", type=Path, help="an .mcap log, or a session folder (all its logs)")
     rep.add_argument("--episode", type=int, help="only this episode (default: all completed)")
+    rep.add_argument(
+        "--view",
+        type=int,
+        action="append",
+        default=[],
+        metavar="PORT",
+        help="also show the replay in FlightGear listening on this UDP port "
+        "(real time; see gymfg_il.viz.flightgear)",
+    )
     if argv and argv[0].endswith(".toml"):
         r = argparse.ArgumentParser(
             prog="python -m gymfg_il.collect RECIPE.toml",
@@ -203,7 +220,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "recover":
             return recover(args.dir)
         if args.command == "replay":
-            return replay(args.log, args.episode)
+            return replay(args.log, args.episode, args.view)
         if args.command == "dagger":
             return dagger(args)
         if args.command == "manual":
@@ -276,17 +293,23 @@ def manual_from_args(args: argparse.Namespace) -> int:
     )
     if args.episodes == 0:
         cfg.episodes = 0
-    return manual(cfg)
+    return manual(cfg, tuple(args.view))
 
 
-def manual(cfg: object) -> int:
+def manual(cfg: object, views: tuple[int, ...] = ()) -> int:
     from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.manual.session import ManualSession
     from gymfg_il.parallel import EnvSpec
 
     assert isinstance(cfg, CollectConfig)
     spec = EnvSpec(
-        cfg.task, cfg.aircraft, cfg.dynamic, cfg.agent_hz, cfg.episode_time_s, dict(cfg.task_kwargs)
+        cfg.task,
+        cfg.aircraft,
+        cfg.dynamic,
+        cfg.agent_hz,
+        cfg.episode_time_s,
+        dict(cfg.task_kwargs),
+        views,
     )
     session = ManualSession(
         spec,
@@ -334,11 +357,11 @@ def dagger(args: argparse.Namespace) -> int:
     return 0
 
 
-def replay(target: Path, episode: int | None) -> int:
+def replay(target: Path, episode: int | None, views: list[int] | None = None) -> int:
     from gymfg_il.collectors.autopilot import LOGS
     from gymfg_il.errors import ConfigError
     from gymfg_il.recording.reader import read_log
-    from gymfg_il.recording.replay import replay_episode
+    from gymfg_il.recording.replay import env_from_session, replay_episode
 
     paths = sorted((target / LOGS).glob("*.mcap")) if target.is_dir() else [target]
     if not paths:
@@ -351,7 +374,10 @@ def replay(target: Path, episode: int | None) -> int:
             raise ConfigError(f"{path.name} has no completed episode {episode}")
         for ep in chosen:
             for callsign in sorted(ep.steps):
-                r = replay_episode(log, ep, callsign)
+                env = env_from_session(log.session, views) if views else None
+                r = replay_episode(log, ep, callsign, env=env)
+                if env is not None:
+                    env.close()
                 verdict = (
                     "identical"
                     if r.identical

@@ -29,6 +29,7 @@ class EnvSpec:
     agent_hz: int = 10
     episode_time_s: float = 90.0
     task_kwargs: dict[str, Any] = field(default_factory=dict)
+    views: tuple[int, ...] = ()  # FlightGear UDP ports (real time while attached)
 
     def make(self) -> AircraftEnv:
         return AircraftEnv(
@@ -38,6 +39,7 @@ class EnvSpec:
             task_kwargs=self.task_kwargs,
             agent_hz=self.agent_hz,
             episode_time_s=self.episode_time_s,
+            views=self.views or None,
         )
 
 

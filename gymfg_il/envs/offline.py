@@ -36,7 +36,8 @@ class OfflineEnv:
     Args:
         opponents: ``[(team, [agent per aircraft in roster order]), ...]``: teams flown by the
             environment itself.
-        sim_hz, agent_hz, opponent_view, scenario: see ``EnvConfig``.
+        sim_hz, agent_hz, opponent_view, scenario, views: see ``EnvConfig`` (views:
+            callsign -> FlightGear UDP ports).
 
     ``reset(team)`` returns ``(team_state, opponent_states)``: one observation (float32) per
     aircraft of ``team`` in roster order, and an ``(n, len(opponent_view))`` array of what the
@@ -57,8 +58,9 @@ class OfflineEnv:
         agent_hz: int = 10,
         opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW,
         scenario: Scenario | None = None,
+        views: Mapping[str, Sequence[int]] | None = None,
     ) -> None:
-        self.config = EnvConfig(sim_hz, agent_hz, tuple(opponent_view), scenario)
+        self.config = EnvConfig(sim_hz, agent_hz, tuple(opponent_view), scenario, views)
         self.opponents: list[tuple[Team, list[Agent]]] = []
         for entry in opponents:
             if not (isinstance(entry, tuple) and len(entry) == 2 and isinstance(entry[0], Team)):

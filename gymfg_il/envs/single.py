@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -34,6 +34,8 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         agent_hz: agent rate (Hz), an exact divisor of ``sim_hz``.
         sim_hz: JSBSim rate (Hz).
         episode_time_s: episode length; reaching it sets ``truncated``.
+        views: UDP ports of FlightGear views of the aircraft (``viz.flightgear``); with a view
+            attached the env runs at real time.
 
     Observation: the task's observation (float32, names in ``env.observation_names``; see the
     task's docstring for the table with units). Action: ``Box([-1, -1, -1, 0], [1, 1, 1, 1])`` =
@@ -60,6 +62,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         sim_hz: int = 120,
         episode_time_s: float = 90.0,
         render_mode: str | None = None,
+        views: Sequence[int] | None = None,
     ) -> None:
         if render_mode is not None:
             raise ConfigError(f"render_mode={render_mode!r} is not supported; use None")
@@ -76,7 +79,12 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
             raise ConfigError(f"task={task!r} must be a family name, a Task class or instance")
         self.aircraft = Aircraft(aircraft, "ego")
         team = Team("ego", [(self.aircraft, spec)], episode_time_s=episode_time_s)
-        self.world = World([team], EnvConfig(sim_hz=sim_hz, agent_hz=agent_hz))
+        self.world = World(
+            [team],
+            EnvConfig(
+                sim_hz=sim_hz, agent_hz=agent_hz, views={"ego": list(views)} if views else None
+            ),
+        )
         self._slot = self.world.slots[0]
         self.task = self._slot.task
         low, high = self.task.observation_bounds()

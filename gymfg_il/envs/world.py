@@ -8,10 +8,12 @@ clock; it knows nothing about who chooses the actions.
 from __future__ import annotations
 
 import math
+import time
 import zlib
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -42,12 +44,16 @@ class EnvConfig:
         opponent_view: the state variables an aircraft sees of other teams' aircraft
             (position and orientation by default, as in the paper).
         scenario: joint initial conditions overriding the tasks' own (see ``envs.scenarios``).
+        views: callsign -> UDP ports of FlightGear views of that aircraft. Only aircraft
+            listed here open a socket (the paper warns that a view per aircraft can load a
+            network); while any view is attached the simulation paces itself to real time.
     """
 
     sim_hz: int = DEFAULT_SIM_HZ
     agent_hz: int = DEFAULT_AGENT_HZ
     opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW
     scenario: Scenario | None = None
+    views: Mapping[str, Sequence[int]] | None = None
 
     def __post_init__(self) -> None:
         substeps(self.sim_hz, self.agent_hz)
@@ -173,6 +179,14 @@ class World:
         self.external: dict[str, StateView] = {}
         self._external_targets = external_targets
         self._link_reward_targets()
+        self.senders: dict[str, Any] = {}
+        for callsign, ports in (config.views or {}).items():
+            if callsign not in self.by_callsign:
+                raise ConfigError(f"views name {callsign!r}, which is not in this simulation")
+            from gymfg_il.viz.netfdm import FlightGearSender
+
+            self.senders[callsign] = FlightGearSender(list(ports))
+        self._next_frame = 0.0
         self.steps = 0
         self.started = False
 
@@ -239,6 +253,7 @@ class World:
             slot.history.clear()
         self.steps = 0
         self.started = True
+        self._show()
 
     def advance(self, actions: Sequence[Controls | None]) -> None:
         """Apply one action per slot (None for terminated aircraft), step, score, check ends."""
@@ -260,6 +275,19 @@ class World:
             slot.prev_action = slot.action
             slot.action = np.array(act)
         self.steps += 1
+        self._show()
+
+    def _show(self) -> None:
+        """Feed the FlightGear views, at real time (FlightGear drops packets that come faster)."""
+        if not self.senders:
+            return
+        for callsign, sender in self.senders.items():
+            slot = self.by_callsign[callsign]
+            sender.send(slot.sim.fdm, slot.sim.engines)
+        now = time.perf_counter()
+        if self._next_frame > now:
+            time.sleep(self._next_frame - now)
+        self._next_frame = max(now, self._next_frame) + self.dt
 
     def score(self) -> None:
         """Rewards and terminations of the step just taken."""
@@ -312,5 +340,8 @@ class World:
         return np.stack(rows)
 
     def close(self) -> None:
+        for sender in self.senders.values():
+            sender.close()
+        self.senders = {}
         self.pool.give_back([s.sim for s in self.slots])
         self.slots = []

@@ -25,7 +25,7 @@ class ReplayResult:
     first_mismatch: int | None
 
 
-def env_from_session(session: dict[str, object]) -> AircraftEnv:
+def env_from_session(session: dict[str, object], views: list[int] | None = None) -> AircraftEnv:
     spec = session.get("env")
     if not isinstance(spec, dict):
         raise ConfigError("the log's session record has no env spec; it cannot be replayed")
@@ -37,6 +37,7 @@ def env_from_session(session: dict[str, object]) -> AircraftEnv:
         agent_hz=int(spec["agent_hz"]),
         sim_hz=int(spec["sim_hz"]),
         episode_time_s=float(spec["episode_time_s"]),
+        views=views,
     )
 
 

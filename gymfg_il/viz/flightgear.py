@@ -1,0 +1,155 @@
+"""Starting FlightGear as a view of a JSBSim aircraft, and reading what it shows.
+
+``FlightGear(port=..., telnet_port=...)`` starts ``fgfs`` with the external FDM switched off
+and the native-fdm socket listening (``--fdm=null --native-fdm=socket,in,RATE,,PORT,udp``),
+no sound, no scenery download and a telnet property server, so a program can read FlightGear's
+own ``/position`` and ``/orientation``. Debian/Ubuntu: ``apt-get install flightgear`` (it lands
+in /usr/games); under Xvfb it needs ``dbus-run-session`` in front, which the launcher adds when
+it is there.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+from gymfg_il.errors import GymFGError
+
+SEARCH = (os.environ.get("PATH", ""), "/usr/games", "/usr/local/games")
+
+
+class FlightGearError(GymFGError, RuntimeError):
+    """FlightGear is missing, failed to start, or stopped answering."""
+
+
+def find_fgfs() -> str | None:
+    return shutil.which("fgfs", path=os.pathsep.join(SEARCH))
+
+
+class FlightGear:
+    """A running ``fgfs`` bound to one native-fdm UDP port.
+
+    Args:
+        port: UDP port the view listens on (the env's ``views`` send there).
+        telnet_port: FlightGear's property server (``get /position/altitude-ft``).
+        aircraft: FlightGear aircraft to draw (``c172p`` ships with the Debian package).
+        rate_hz: packets per second FlightGear expects.
+        geometry: window size.
+        display: X display (e.g. an Xvfb's ``:99``); the current one by default.
+        airport: where FlightGear starts (and loads scenery) before the first packet moves
+            it; GymFG's default start is near KSFO, whose scenery ships with FlightGear.
+        extra: more fgfs options.
+    """
+
+    def __init__(
+        self,
+        port: int,
+        telnet_port: int,
+        aircraft: str = "c172p",
+        rate_hz: int = 30,
+        geometry: str = "800x600",
+        display: str | None = None,
+        airport: str = "KSFO",
+        extra: tuple[str, ...] = (),
+    ) -> None:
+        exe = find_fgfs()
+        if exe is None:
+            raise FlightGearError(
+                "fgfs (FlightGear) is not installed or not on the PATH; on Debian or Ubuntu: "
+                "sudo apt-get install flightgear (it installs into /usr/games)"
+            )
+        self.port, self.telnet_port = port, telnet_port
+        self.home = tempfile.mkdtemp(prefix="gymfg-fghome-")
+        cmd = [
+            exe,
+            "--fdm=null",
+            f"--native-fdm=socket,in,{rate_hz},,{port},udp",
+            f"--aircraft={aircraft}",
+            f"--telnet=socket,bi,10,localhost,{telnet_port},tcp",
+            "--disable-sound",
+            "--disable-terrasync",
+            "--launcher=0",
+            "--timeofday=noon",
+            f"--geometry={geometry}",
+            "--disable-splash-screen",
+            "--disable-ai-traffic",
+            f"--airport={airport}",
+            "--prop:/sim/rendering/multi-sample-buffers=0",
+            *extra,
+        ]
+        if shutil.which("dbus-run-session"):
+            cmd = ["dbus-run-session", "--", *cmd]
+        env = {**os.environ, "FG_HOME": self.home}
+        if display:
+            env["DISPLAY"] = display
+        self.log_path = Path(self.home) / "fgfs.log"
+        self._log = open(self.log_path, "wb")  # noqa: SIM115 (closed in stop())
+        self.proc = subprocess.Popen(
+            cmd, env=env, stdout=self._log, stderr=subprocess.STDOUT, start_new_session=True
+        )
+        self._sock: socket.socket | None = None
+
+    def wait_ready(self, timeout_s: float = 300.0) -> None:
+        """Wait until FlightGear has loaded its scenery (the first start also builds a navaid
+        cache; software rendering under Xvfb draws about a frame a second)."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise FlightGearError(
+                    f"fgfs exited with {self.proc.returncode}; see {self.log_path}"
+                )
+            try:
+                if self.get("/sim/sceneryloaded") in ("true", "1"):
+                    return
+            except OSError:
+                pass
+            time.sleep(1.0)
+        raise FlightGearError(f"fgfs did not come up within {timeout_s:g} s; see {self.log_path}")
+
+    def _connect(self) -> socket.socket:
+        if self._sock is None:
+            # software-rendered FlightGear answers once a frame: be patient
+            sock = socket.create_connection(("127.0.0.1", self.telnet_port), timeout=30)
+            sock.sendall(b"data\r\n")  # raw replies, no prompts
+            self._sock = sock
+        return self._sock
+
+    def get(self, prop: str) -> str:
+        """A property's value as FlightGear shows it."""
+        sock = self._connect()
+        try:
+            sock.sendall(f"get {prop}\r\n".encode())
+            data = b""
+            while not data.endswith(b"\n"):
+                chunk = sock.recv(4096)
+                if not chunk:
+                    raise OSError("FlightGear closed the property connection")
+                data += chunk
+        except OSError:
+            self._sock = None
+            raise
+        return data.decode(errors="replace").strip()
+
+    def get_float(self, prop: str) -> float:
+        return float(self.get(prop))
+
+    def stop(self) -> None:
+        if self._sock is not None:
+            self._sock.close()
+            self._sock = None
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGTERM)
+            try:
+                self.proc.wait(15)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait(5)
+        self._log.close()
+        if self.proc.returncode in (0, -signal.SIGTERM, -signal.SIGKILL):
+            shutil.rmtree(self.home, ignore_errors=True)  # a crash keeps its log
