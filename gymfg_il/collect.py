@@ -16,10 +16,6 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from gymfg_il.datasets.from_logs import BuildReport
 
 EPILOG = __doc__.split("\n\n", 1)[1]
 
@@ -198,28 +194,18 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     return args
 
 
-def _report_build(report: BuildReport, root: Path) -> None:
-    r = report
-    note = ", rebuilt from the logs" if r.rebuilt else ""
-    print(
-        f"dataset {root}: {r.total_episodes} episodes (+{r.added}, {r.frames} frames in "
-        f"{r.seconds:.2f} s{note})"
-    )
-    if r.skipped_incomplete:
-        print(
-            f"left out {r.skipped_incomplete} unfinished episode(s) (the session stopped "
-            "mid-episode)"
-        )
-
-
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(list(sys.argv[1:] if argv is None else argv))
     from gymfg_il.errors import GymFGError
 
     try:
         if args.command == "recover":
+            from gymfg_il.collectors.commands import recover
+
             return recover(args.dir)
         if args.command == "replay":
+            from gymfg_il.collectors.commands import replay
+
             return replay(args.log, args.episode, args.view)
         if args.command == "dagger":
             return dagger(args)
@@ -253,6 +239,7 @@ def collect(cfg: object, progress: bool = True, workers: int = 1) -> int:
     from tqdm import tqdm
 
     from gymfg_il.collectors.autopilot import DATASET, LOGS, record_autopilot
+    from gymfg_il.collectors.commands import report_build
     from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.datasets.from_logs import build_from_logs
 
@@ -271,7 +258,7 @@ def collect(cfg: object, progress: bool = True, workers: int = 1) -> int:
     bar.close()
     print(f"logged {len(result.episodes)} episodes ({result.steps} steps) to {result.log}")
     report = build_from_logs(sorted((cfg.out / LOGS).glob("*.mcap")), cfg.out / DATASET)
-    _report_build(report, cfg.out / DATASET)
+    report_build(report, cfg.out / DATASET)
     return 0
 
 
@@ -354,53 +341,6 @@ def dagger(args: argparse.Namespace) -> int:
         f"final policy: {history[-1].policy} (evaluate it: python -m gymfg_il.eval "
         f"--policy {history[-1].policy})"
     )
-    return 0
-
-
-def replay(target: Path, episode: int | None, views: list[int] | None = None) -> int:
-    from gymfg_il.collectors.autopilot import LOGS
-    from gymfg_il.errors import ConfigError
-    from gymfg_il.recording.reader import read_log
-    from gymfg_il.recording.replay import env_from_session, replay_episode
-
-    paths = sorted((target / LOGS).glob("*.mcap")) if target.is_dir() else [target]
-    if not paths:
-        raise ConfigError(f"no logs under {target}")
-    failures = 0
-    for path in paths:
-        log = read_log(path)
-        chosen = [e for e in log.complete_episodes if episode is None or e.index == episode]
-        if episode is not None and not chosen:
-            raise ConfigError(f"{path.name} has no completed episode {episode}")
-        for ep in chosen:
-            for callsign in sorted(ep.steps):
-                env = env_from_session(log.session, views) if views else None
-                r = replay_episode(log, ep, callsign, env=env)
-                if env is not None:
-                    env.close()
-                verdict = (
-                    "identical"
-                    if r.identical
-                    else (f"DIFFERS from step {r.first_mismatch} (max |diff| {r.max_abs_diff:.3g})")
-                )
-                print(f"{path.name} episode {ep.index} {callsign}: {r.steps} steps, {verdict}")
-                failures += not r.identical
-    return 1 if failures else 0
-
-
-def recover(folder: Path) -> int:
-    from gymfg_il.collectors.autopilot import DATASET, LOGS
-    from gymfg_il.datasets.from_logs import build_from_logs
-    from gymfg_il.errors import ConfigError
-
-    logs = sorted((folder / LOGS).glob("*.mcap")) if folder.is_dir() else []
-    if not logs:
-        raise ConfigError(
-            f"{folder} holds no {LOGS}/*.mcap: nothing to recover from (is it a "
-            "collection session folder?)"
-        )
-    report = build_from_logs(logs, folder / DATASET)
-    _report_build(report, folder / DATASET)
     return 0
 
 
