@@ -7,10 +7,10 @@ import torch
 from torch import nn
 
 from gymfg_il.policies.configuration_mlp import MLPConfig
-from gymfg_il.policies.normalize import Normalizer
+from gymfg_il.policies.normalize import NormalizedPolicy
 
 
-class MLPPolicy(nn.Module):
+class MLPPolicy(NormalizedPolicy):
     recurrent = False
 
     def __init__(
@@ -19,11 +19,9 @@ class MLPPolicy(nn.Module):
         obs_stats: dict[str, np.ndarray],
         action_stats: dict[str, np.ndarray],
     ) -> None:
-        super().__init__()
-        self.config = config
-        self.obs_norm = Normalizer(obs_stats["mean"], obs_stats["std"])
-        self.action_norm = Normalizer(action_stats["mean"], action_stats["std"])
-        n_obs, n_act = len(obs_stats["mean"]), len(action_stats["mean"])
+        super().__init__(config, obs_stats, action_stats)
+        self.config: MLPConfig = config
+        n_obs, n_act = self.n_obs, self.n_act
         layers: list[nn.Module] = []
         width = n_obs
         for h in config.hidden:

@@ -23,3 +23,18 @@ class Normalizer(nn.Module):
 
     def inverse(self, x: torch.Tensor) -> torch.Tensor:
         return x * self.std + self.mean
+
+
+class NormalizedPolicy(nn.Module):
+    """What every policy shares: its config and the observation and action normalisers, so
+    the checkpoint carries the dataset's statistics. Subclasses build the network on
+    ``self.n_obs`` inputs and ``self.n_act`` (normalised) outputs."""
+
+    def __init__(
+        self, config: object, obs_stats: dict[str, np.ndarray], action_stats: dict[str, np.ndarray]
+    ) -> None:
+        super().__init__()
+        self.config = config
+        self.obs_norm = Normalizer(obs_stats["mean"], obs_stats["std"])
+        self.action_norm = Normalizer(action_stats["mean"], action_stats["std"])
+        self.n_obs, self.n_act = len(obs_stats["mean"]), len(action_stats["mean"])
