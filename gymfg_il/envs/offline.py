@@ -36,8 +36,9 @@ class OfflineEnv:
     Args:
         opponents: ``[(team, [agent per aircraft in roster order]), ...]``: teams flown by the
             environment itself.
-        sim_hz, agent_hz, opponent_view, scenario, views: see ``EnvConfig`` (views:
-            callsign -> FlightGear UDP ports).
+        sim_hz, agent_hz, opponent_view, scenario, views, traffic: see ``EnvConfig``
+            (views: callsign -> FlightGear UDP ports; traffic: callsign -> the multiplayer
+            ports of its views, where the other aircraft are shown).
 
     ``reset(team)`` returns ``(team_state, opponent_states)``: one observation (float32) per
     aircraft of ``team`` in roster order, and an ``(n, len(opponent_view))`` array of what the
@@ -59,8 +60,9 @@ class OfflineEnv:
         opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW,
         scenario: Scenario | None = None,
         views: Mapping[str, Sequence[int]] | None = None,
+        traffic: Mapping[str, Sequence[int]] | None = None,
     ) -> None:
-        self.config = EnvConfig(sim_hz, agent_hz, tuple(opponent_view), scenario, views)
+        self.config = EnvConfig(sim_hz, agent_hz, tuple(opponent_view), scenario, views, traffic)
         self.opponents: list[tuple[Team, list[Agent]]] = []
         for entry in opponents:
             if not (isinstance(entry, tuple) and len(entry) == 2 and isinstance(entry[0], Team)):

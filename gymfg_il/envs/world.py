@@ -22,7 +22,14 @@ from gymfg_il.envs.actions import Controls
 from gymfg_il.envs.team import Team, build_task, check_unique
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
-from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, NAMES, StateView, indices
+from gymfg_il.sim.properties import (
+    DEFAULT_OPPONENT_VIEW,
+    NAMES,
+    ORIENTATION,
+    POSITION,
+    StateView,
+    indices,
+)
 from gymfg_il.sim.simulation import Simulation
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, episode_steps, substeps
 from gymfg_il.tasks.base import Task
@@ -47,6 +54,9 @@ class EnvConfig:
         views: callsign -> UDP ports of FlightGear views of that aircraft. Only aircraft
             listed here open a socket (the paper warns that a view per aircraft can load a
             network); while any view is attached the simulation paces itself to real time.
+        traffic: callsign -> multiplayer UDP ports of the views of that aircraft
+            (``FlightGear(multiplayer_port=...)``): every other aircraft of the simulation,
+            opponents of an online client included, is sent there and appears in the view.
     """
 
     sim_hz: int = DEFAULT_SIM_HZ
@@ -54,9 +64,23 @@ class EnvConfig:
     opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW
     scenario: Scenario | None = None
     views: Mapping[str, Sequence[int]] | None = None
+    traffic: Mapping[str, Sequence[int]] | None = None
 
     def __post_init__(self) -> None:
         substeps(self.sim_hz, self.agent_hz)
+        from gymfg_il.viz.multiplayer import MAX_PORT
+
+        bad = [
+            (c, p)
+            for c, ports in (self.traffic or {}).items()
+            for p in ports
+            if not (isinstance(p, int) and 0 < p <= MAX_PORT)
+        ]
+        if bad:
+            raise ConfigError(
+                f"traffic ports {bad}: FlightGear 2020.3 keeps multiplayer ports in a signed "
+                f"16-bit property; give each view a port in 1..{MAX_PORT}"
+            )
         view = tuple(self.opponent_view)
         object.__setattr__(self, "opponent_view", view)
         indices(view)
@@ -186,6 +210,14 @@ class World:
             from gymfg_il.viz.netfdm import FlightGearSender
 
             self.senders[callsign] = FlightGearSender(list(ports))
+        self.traffic: dict[str, Any] = {}
+        for callsign, ports in (config.traffic or {}).items():
+            if callsign not in self.by_callsign:
+                raise ConfigError(f"traffic names {callsign!r}, which is not in this simulation")
+            from gymfg_il.viz.multiplayer import TrafficSender
+
+            self.traffic[callsign] = TrafficSender(list(ports))
+        self._pose_idx = indices(POSITION + ORIENTATION)
         self._next_frame = 0.0
         self.steps = 0
         self.started = False
@@ -279,15 +311,28 @@ class World:
 
     def _show(self) -> None:
         """Feed the FlightGear views, at real time (FlightGear drops packets that come faster)."""
-        if not self.senders:
+        if not (self.senders or self.traffic):
             return
         for callsign, sender in self.senders.items():
             slot = self.by_callsign[callsign]
             sender.send(slot.sim.fdm, slot.sim.engines)
+        if self.traffic:
+            self._send_traffic()
         now = time.perf_counter()
         if self._next_frame > now:
             time.sleep(self._next_frame - now)
         self._next_frame = max(now, self._next_frame) + self.dt
+
+    def _send_traffic(self) -> None:
+        poses = [(s.callsign, s.aircraft.model, s.state[self._pose_idx]) for s in self.slots]
+        for callsign, view in self.external.items():  # an online client's opponents
+            if all(name in view for name in POSITION + ORIENTATION):
+                pose = [view[name] for name in POSITION + ORIENTATION]
+                poses.append((callsign, "", pose))  # model unknown: FlightGear's fallback
+        for viewer, sender in self.traffic.items():
+            for callsign, model, pose in poses:
+                if callsign != viewer:
+                    sender.send(callsign, model, pose)
 
     def score(self) -> None:
         """Rewards and terminations of the step just taken."""
@@ -340,8 +385,8 @@ class World:
         return np.stack(rows)
 
     def close(self) -> None:
-        for sender in self.senders.values():
+        for sender in [*self.senders.values(), *self.traffic.values()]:
             sender.close()
-        self.senders = {}
+        self.senders, self.traffic = {}, {}
         self.pool.give_back([s.sim for s in self.slots])
         self.slots = []

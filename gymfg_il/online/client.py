@@ -10,7 +10,7 @@ others.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -32,6 +32,9 @@ class OnlineEnv:
         timeout_s: how long to wait for the server before giving up (a ``wait`` message from
             a paused server restarts the clock).
         sim_hz, agent_hz: rates, as in ``OfflineEnv``.
+        views, traffic: FlightGear views of the team's aircraft, as in ``OfflineEnv``; the
+            opponents appear in them as multiplayer traffic (from what the server lets the
+            team see of them).
 
     ``reset`` and ``step`` return what ``OfflineEnv`` returns; ``truncated`` also becomes True
     when the server ends the simulation (in a k-fixed simulation, when any team completes),
@@ -47,11 +50,13 @@ class OnlineEnv:
         timeout_s: float = 10.0,
         sim_hz: int = 120,
         agent_hz: int = 10,
+        views: Mapping[str, Sequence[int]] | None = None,
+        traffic: Mapping[str, Sequence[int]] | None = None,
     ) -> None:
         import zmq
 
         self.address, self.token, self.timeout_s = address, token, timeout_s
-        self.config = EnvConfig(sim_hz, agent_hz)
+        self.config = EnvConfig(sim_hz, agent_hz, views=views, traffic=traffic)
         self._pool = SimPool(sim_hz, agent_hz)
         self.ctx: Any = zmq.Context.instance()
         self.sock = self.ctx.socket(zmq.DEALER)

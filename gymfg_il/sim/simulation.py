@@ -7,10 +7,8 @@ time and plain Python floats, so an agent step costs little beyond the physics i
 
 from __future__ import annotations
 
-import atexit
 import logging
 import os
-import shutil
 import tempfile
 from collections.abc import Callable
 from typing import Any
@@ -24,22 +22,12 @@ from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
 
 log = logging.getLogger(__name__)
 
-_ic_dir: str | None = None
-
 
 def _quiet_jsbsim() -> None:
     """Silence JSBSim's banner and load chatter for every instance made afterwards."""
     import jsbsim
 
     jsbsim.FGJSBBase().debug_lvl = 0
-
-
-def _ic_folder() -> str:
-    global _ic_dir
-    if _ic_dir is None:
-        _ic_dir = tempfile.mkdtemp(prefix="gymfg-ic-")
-        atexit.register(shutil.rmtree, _ic_dir, True)
-    return _ic_dir
 
 
 class Simulation:
@@ -96,8 +84,6 @@ class Simulation:
         self._has_gear = pm.hasNode("gear/gear-cmd-norm")
         self._run = fdm.run
         self._substep_range = range(self.substeps)
-        fd, self._ic_path = tempfile.mkstemp(suffix=".xml", dir=_ic_folder())
-        os.close(fd)
         self.resets = 0
         if self._has_gear:
             self._retract_gear()
@@ -110,10 +96,16 @@ class Simulation:
     def reset(self, ic: InitialConditions, throttle: float = 0.0) -> np.ndarray:
         """Put the aircraft in ``ic`` with engines running; return the first state vector."""
         xml = ic.to_xml().replace("</initialize>", " <running>-1</running>\n</initialize>")
-        with open(self._ic_path, "w", encoding="ascii") as f:
-            f.write(xml)
         fdm = self.fdm
-        fdm.get_ic().load(self._ic_path, False)
+        # JSBSim reads initial conditions only from a file. It lives just for the load, so
+        # worker processes that exit without atexit, or a kill -9, leave nothing behind.
+        fd, path = tempfile.mkstemp(prefix="gymfg-ic-", suffix=".xml")
+        try:
+            with os.fdopen(fd, "w", encoding="ascii") as f:
+                f.write(xml)
+            fdm.get_ic().load(path, False)
+        finally:
+            os.remove(path)
         for prop in self._mixtures:
             fdm[prop] = 1.0
         self.apply(0.0, 0.0, 0.0, throttle, run=False)
@@ -156,5 +148,4 @@ class Simulation:
         return np.array([get() for get in self._getters])
 
     def close(self) -> None:
-        if os.path.exists(self._ic_path):
-            os.remove(self._ic_path)
+        """Nothing to release: the instance holds no files or sockets."""

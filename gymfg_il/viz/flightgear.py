@@ -3,7 +3,9 @@
 ``FlightGear(port=..., telnet_port=...)`` starts ``fgfs`` with the external FDM switched off
 and the native-fdm socket listening (``--fdm=null --native-fdm=socket,in,RATE,,PORT,udp``),
 no sound, no scenery download and a telnet property server, so a program can read FlightGear's
-own ``/position`` and ``/orientation``. Debian/Ubuntu: ``apt-get install flightgear`` (it lands
+own ``/position`` and ``/orientation``. With ``multiplayer_port`` the view also listens for
+multiplayer traffic, so the simulation's other aircraft appear in it (``viz.multiplayer``).
+Debian/Ubuntu: ``apt-get install flightgear`` (it lands
 in /usr/games); under Xvfb it needs ``dbus-run-session`` in front, which the launcher adds when
 it is there.
 """
@@ -22,6 +24,15 @@ from pathlib import Path
 from gymfg_il.errors import GymFGError
 
 SEARCH = (os.environ.get("PATH", ""), "/usr/games", "/usr/local/games")
+
+# Without an FDM of its own FlightGear leaves every tank's density and capacity at 0, and its
+# tank properties then turn any fuel level the native-fdm stream sends into 0 (the c172p then
+# shows "Out of fuel!"). 6 lb per US gallon, as JSBSim counts, and room for any tank.
+FUEL_TANKS = tuple(
+    f"--prop:/consumables/fuel/tank[{i}]/{name}"
+    for i in range(4)
+    for name in ("density-kgpm3=718.9", "capacity-m3=100")
+)
 
 
 class FlightGearError(GymFGError, RuntimeError):
@@ -44,6 +55,8 @@ class FlightGear:
         display: X display (e.g. an Xvfb's ``:99``); the current one by default.
         airport: where FlightGear starts (and loads scenery) before the first packet moves
             it; GymFG's default start is near KSFO, whose scenery ships with FlightGear.
+        multiplayer_port: UDP port for other aircraft (``EnvConfig.traffic``); at most
+            32767, which is all FlightGear 2020.3 can store.
         extra: more fgfs options.
     """
 
@@ -56,8 +69,16 @@ class FlightGear:
         geometry: str = "800x600",
         display: str | None = None,
         airport: str = "KSFO",
+        multiplayer_port: int | None = None,
         extra: tuple[str, ...] = (),
     ) -> None:
+        from gymfg_il.viz.multiplayer import MAX_PORT
+
+        if multiplayer_port is not None and not 0 < multiplayer_port <= MAX_PORT:
+            raise FlightGearError(
+                f"multiplayer_port={multiplayer_port}: FlightGear 2020.3 stores multiplayer "
+                f"ports as signed 16-bit numbers; pick one in 1..{MAX_PORT}"
+            )
         exe = find_fgfs()
         if exe is None:
             raise FlightGearError(
@@ -65,6 +86,18 @@ class FlightGear:
                 "sudo apt-get install flightgear (it installs into /usr/games)"
             )
         self.port, self.telnet_port = port, telnet_port
+        self.multiplayer_port = multiplayer_port
+        # FlightGear only listens when it also has somewhere to send its own position: the
+        # discard port, so no view ever sees another view's aircraft twice
+        traffic = (
+            (
+                f"--multiplay=in,{rate_hz},127.0.0.1,{multiplayer_port}",
+                f"--multiplay=out,{rate_hz},127.0.0.1,9",
+                "--callsign=gymfg-view",
+            )
+            if multiplayer_port
+            else ()
+        )
         self.home = tempfile.mkdtemp(prefix="gymfg-fghome-")
         cmd = [
             exe,
@@ -81,6 +114,8 @@ class FlightGear:
             "--disable-ai-traffic",
             f"--airport={airport}",
             "--prop:/sim/rendering/multi-sample-buffers=0",
+            *FUEL_TANKS,
+            *traffic,
             *extra,
         ]
         if shutil.which("dbus-run-session"):
