@@ -81,7 +81,13 @@ class OnlineEnv:
 
     # -- wire ----------------------------------------------------------------------------
     def _request(self, msg: dict[str, Any], expect: str) -> dict[str, Any]:
+        self._send(msg)
+        return self._receive(expect)
+
+    def _send(self, msg: dict[str, Any]) -> None:
         self.sock.send(encode({**msg, "team": self.team.name, "token": self.token}))  # type: ignore[union-attr]
+
+    def _receive(self, expect: str) -> dict[str, Any]:
         import zmq
 
         while True:
@@ -104,10 +110,12 @@ class OnlineEnv:
             if reply["type"] == expect:
                 return reply
 
-    def _report(self, done: bool) -> dict[str, Any]:
+    def _states(self) -> dict[str, list[float]]:
         assert self.world is not None
-        states = {s.callsign: s.state.tolist() for s in self.world.slots}
-        return self._request({"type": "report", "states": states, "done": done}, "central")
+        return {s.callsign: s.state.tolist() for s in self.world.slots}
+
+    def _report(self, done: bool) -> dict[str, Any]:
+        return self._request({"type": "report", "states": self._states(), "done": done}, "central")
 
     def _opponents(self, central: dict[str, Any]) -> np.ndarray:
         rows = central["opponents"]
@@ -161,9 +169,18 @@ class OnlineEnv:
             raise EnvStateError("call env.reset(team) before step (and again after the end)")
         world.step_physics(team_controls(team_actions, team.callsigns))
         terminated_now = all(s.terminated for s in world.slots)
-        central = self._report(done=world.truncated)
+        self._send({"type": "report", "states": self._states(), "done": world.truncated})
+        # Rewards and observations need the other teams only when a reward targets them:
+        # otherwise they are computed while the server gathers the other reports.
+        early = not world.external
+        if early:
+            world.score()
+            observations = [world.observation(s) for s in world.slots]
+        central = self._receive("central")
         opponents = self._opponents(central)
-        world.score()
+        if not early:
+            world.score()
+            observations = [world.observation(s) for s in world.slots]
         slots = world.slots
         terminated = all(s.terminated for s in slots) or terminated_now
         truncated = (world.truncated or bool(central["done"])) and not terminated
@@ -179,7 +196,7 @@ class OnlineEnv:
         }
         rewards = np.array([s.reward for s in slots])
         return (
-            [world.observation(s) for s in slots],
+            observations,
             opponents,
             rewards,
             terminated,

@@ -336,23 +336,20 @@ class StateServer:
     def run(self, seconds: float | None = None) -> None:
         import zmq
 
-        poller = zmq.Poller()
-        poller.register(self.sock, zmq.POLLIN)
         end = None if seconds is None else time.monotonic() + seconds
-        poll_ms = max(10, int(min(self.config.timeout_s, 1.0) * 250))
+        # a blocking receive with a timeout: one call per message, no poller in between
+        self.sock.setsockopt(zmq.RCVTIMEO, max(10, int(min(self.config.timeout_s, 1.0) * 250)))
+        recv, handle = self.sock.recv_multipart, self.handle
         while not self._stop and (end is None or time.monotonic() < end):
-            if not poller.poll(poll_ms):
+            try:
+                frames = recv()
+            except zmq.Again:
                 self._check_stalls()
                 continue
-            while True:
-                try:
-                    frames = self.sock.recv_multipart(flags=zmq.NOBLOCK)
-                except zmq.Again:
-                    break
-                if len(frames) != 2:
-                    log.warning("dropped a message of %d frames", len(frames))
-                    continue
-                self.handle(frames[0], frames[1])
+            if len(frames) == 2:
+                handle(frames[0], frames[1])
+            else:
+                log.warning("dropped a message of %d frames", len(frames))
             now = time.monotonic()
             if now - self._last_stall_check > 0.05:  # not after every message
                 self._last_stall_check = now
