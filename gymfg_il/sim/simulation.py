@@ -123,9 +123,10 @@ class Simulation:
         at build time makes every episode start alike.
         """
         self.reset(InitialConditions(altitude_ft=30000.0, airspeed_kts=250.0))
-        for _ in range(60 * self.sim_hz):
-            if self.fdm["gear/gear-pos-norm"] <= 0.0:
-                break
+        for frame in range(60 * self.sim_hz):
+            position = self.fdm["gear/gear-pos-norm"]
+            if position <= 0.0 or (frame == self.sim_hz and position >= 1.0):
+                break  # stowed, or fixed gear (it has not moved in a second): nothing to do
             self._run()
         self.resets = 0
 
