@@ -101,10 +101,31 @@ class Autopilot:
 
     def track(self, applied: np.ndarray) -> None:
         """Follow an action someone else applied (see ``PID.track``): the surface loops'
-        integrals are set so this controller would have output it."""
-        self.roll_pid.track(float(applied[0]))
-        self.pitch_pid.track(-float(applied[1]))
-        self.speed_pid.track(float(applied[3]))
+        integrals are set so this controller would have output it.
+
+        A loop whose error integral the observation carries (``roll_deg_error_integral`` for
+        a roll target, ...) keeps its own integral instead: it equals that observed value,
+        so a label from this controller stays a function of the observation, which is
+        what a memoryless policy can learn (DAgger)."""
+        observed = self._observed_integrals
+        if "roll" not in observed:
+            self.roll_pid.track(float(applied[0]))
+        if "pitch" not in observed:
+            self.pitch_pid.track(-float(applied[1]))
+        if "speed" not in observed:
+            self.speed_pid.track(float(applied[3]))
+
+    @property
+    def _observed_integrals(self) -> set[str]:
+        t, names = self.targets, self.index
+        out = set()
+        if t.lateral == "roll" and "roll_deg_error_integral" in names:
+            out.add("roll")
+        if t.vertical == "pitch" and "pitch_deg_error_integral" in names:
+            out.add("pitch")
+        if isinstance(t.speed_source, str) and "airspeed_kts_error_integral" in names:
+            out.add("speed")
+        return out
 
     def set_throttle_trim(self, throttle: float) -> None:
         self.throttle_trim = throttle

@@ -52,8 +52,10 @@ class DummyTask(Task):
 
 _TARGET_DOC = """
 
-    Observation: ``FLIGHT_VARS`` {extra}then ``{var}_target`` ({unit}) and ``{var}_error``
-    (target - value{wrap}).
+    Observation: ``FLIGHT_VARS`` {extra}then ``{var}_target`` ({unit}), ``{var}_error``
+    (target - value{wrap}) and ``{var}_error_integral`` ({unit}·s: the error summed over the
+    episode's steps times dt, the current one included, as a PID's integral term counts it;
+    it lets a memoryless policy hold the target without a steady offset).
     Target: {target}.
     Reward per step: ``exp(-|error| / {scale:g}) - 0.05 * mean |change of aileron, elevator,
     rudder|`` (at most 1).

@@ -60,6 +60,8 @@ AIRSPEED = TargetFamily("airspeed", "airspeed_kts", True, (-20.0, 20.0), 5.0, 3.
 FAMILIES: dict[str, TargetFamily] = {f.key: f for f in (ALTITUDE, ROLL, PITCH, HEADING, AIRSPEED)}
 
 SMOOTHNESS_WEIGHT = 0.05
+# the error integral observed by target tasks saturates at this many seconds of full error
+INTEGRAL_LIMIT_S = 60.0
 
 
 class TargetTask(Task):
@@ -109,6 +111,8 @@ class TargetTask(Task):
         self._var = INDEX[fam.variable]
         self._targets: np.ndarray = np.zeros(1)
         self.start_value = 0.0
+        self._integral = 0.0
+        self._integral_step = -1
 
     @property
     def observation_vars(self) -> tuple[str, ...]:  # type: ignore[override]
@@ -117,12 +121,17 @@ class TargetTask(Task):
     @property
     def extra_names(self) -> tuple[str, ...]:  # type: ignore[override]
         v = self.family.variable
-        return (f"{v}_target", f"{v}_error")
+        return (f"{v}_target", f"{v}_error", f"{v}_error_integral")
 
     def _extra_bounds(self) -> tuple[list[float], list[float]]:
         var = BY_NAME[self.family.variable]
-        span = 180.0 if self.family.angular else var.high - var.low
-        return [var.low, -span], [var.high, span]
+        span = self._span()
+        limit = span * INTEGRAL_LIMIT_S
+        return [var.low, -span, -limit], [var.high, span, limit]
+
+    def _span(self) -> float:
+        var = BY_NAME[self.family.variable]
+        return 180.0 if self.family.angular else var.high - var.low
 
     def _draw(self, rng: np.random.Generator) -> float:
         low, high = self.target_range
@@ -134,6 +143,7 @@ class TargetTask(Task):
         return value % 360.0 if self.family.angular else value
 
     def reset(self, state: np.ndarray, rng: np.random.Generator) -> None:
+        self._integral, self._integral_step = 0.0, -1
         self.start_value = float(state[self._var])
         first = self.fixed_target if self.fixed_target is not None else self._draw(rng)
         n = self.max_steps + 1
@@ -169,14 +179,20 @@ class TargetTask(Task):
 
     def observe(self, state: np.ndarray, step: int) -> np.ndarray:
         n = self._n_vars
-        obs = np.empty(n + 2, np.float32)
+        obs = np.empty(n + 3, np.float32)
         obs[:n] = state[self._obs_idx]
         target = self.target_value(step)
         err = target - state[self._var]
         if self.family.angular:
             err = (err + 180.0) % 360.0 - 180.0
+        if step > self._integral_step:  # once per step, however often it is observed
+            missed = step - self._integral_step if self._integral_step >= 0 else 1
+            limit = self._span() * INTEGRAL_LIMIT_S
+            self._integral = max(-limit, min(limit, self._integral + err * self.dt * missed))
+            self._integral_step = step
         obs[n] = target
         obs[n + 1] = err
+        obs[n + 2] = self._integral
         return obs
 
     def task_reward(self, ctx: RewardContext) -> float:

@@ -31,7 +31,7 @@ def fly(family, model, target, seconds=150, dynamic=False):
     while not done:
         action = pilot.act(obs)
         obs, _, terminated, truncated, _ = env.step(action)
-        errors.append(obs[-1])
+        errors.append(obs[-2])  # the target's error
         actions.append(action)
         done = terminated or truncated
     env.close()

@@ -23,7 +23,7 @@ def test_agents_see_their_task_and_the_other_team():
     assert env.agents == ["red-one", "red-two", "blue-one"]
     assert obs["red-one"]["opponents"].shape == (1, 6)
     assert obs["blue-one"]["opponents"].shape == (2, 6)
-    assert obs["red-two"]["observation"].shape == (12,)
+    assert obs["red-two"]["observation"].shape == (13,)
     steps = 0
     while env.agents:
         *_, truncs, _ = env.step(dict.fromkeys(env.agents, np.array([0, 0, 0, 0.8])))

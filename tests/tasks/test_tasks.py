@@ -40,8 +40,21 @@ def test_static_target_is_fixed_and_relative_to_start():
     task.reset(state(altitude_ft=4000), np.random.default_rng(0))
     assert task.target_value(0) == task.target_value(899) == 4500
     obs = task.observe(state(altitude_ft=4100), 10)
-    assert obs[-2] == 4500 and obs[-1] == 400
+    assert obs[-3] == 4500 and obs[-2] == 400
     assert len(obs) == len(task.observation_names)
+
+
+def test_error_integral_sums_each_step_once_and_restarts_with_the_episode():
+    task = bound(tasks.ReachStaticTargetRollTask(target=10))
+    assert task.observation_names[-1] == "roll_deg_error_integral"
+    for _ in range(2):
+        task.reset(state(roll_deg=0), np.random.default_rng(0))
+        integrals = []
+        for step, roll in enumerate([0.0, 4.0, 8.0, 12.0]):
+            task.observe(state(roll_deg=roll), step)  # observed twice: counted once
+            integrals.append(task.observe(state(roll_deg=roll), step)[-1])
+        # errors 10, 6, 2, -2 deg, dt 0.1 s
+        assert integrals == pytest.approx([1.0, 1.6, 1.8, 1.6])
 
 
 def test_dynamic_target_moves_at_its_rate_and_is_seeded():
@@ -63,7 +76,7 @@ def test_heading_error_wraps_across_north():
     assert task.target_value(0) == pytest.approx(10)
     assert task.error(355, 0) == pytest.approx(15)
     obs = task.observe(state(heading_deg=5), 0)
-    assert obs[-1] == pytest.approx(5)
+    assert obs[-2] == pytest.approx(5)
 
 
 def test_reward_is_one_lambda_over_states_and_targets():
