@@ -311,8 +311,32 @@ def online_client(address: str, name: str, steps: int) -> None:
     env.close()
 
 
-def online(teams: int, steps: int) -> float:
-    """Simulation steps/s of ``teams`` client processes in lockstep with a real server."""
+def bare_client(address: str, name: str, steps: int) -> None:
+    """The messaging alone: one team reporting a fixed state every step, no simulation."""
+    import zmq
+
+    from gymfg_il.online.protocol import decode, encode
+    from gymfg_il.sim.properties import NAMES
+
+    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock.connect(address)
+    sock.send(encode({"type": "join", "team": name, "token": "", "aircraft": {name: "c172p"}}))
+    decode(sock.recv(), "server")
+    report = encode(
+        {"type": "report", "team": name, "token": "", "states": {name: [0.5] * len(NAMES)}}
+    )
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        sock.send(report)
+        while decode(sock.recv(), "server")["type"] != "central":
+            pass
+    print(f"RATE {steps / (time.perf_counter() - t0)}", flush=True)
+    sock.close(0)
+
+
+def online(teams: int, steps: int, bare: bool = False) -> float:
+    """Simulation steps/s of ``teams`` client processes in lockstep with a real server
+    (``bare``: clients that only report, the messaging's own ceiling)."""
     import socket
     import subprocess
 
@@ -339,7 +363,14 @@ def online(teams: int, steps: int) -> float:
         address = f"tcp://127.0.0.1:{port}"
         clients = [
             subprocess.Popen(
-                [sys.executable, __file__, "--online-client", address, f"team{i}", str(steps)],
+                [
+                    sys.executable,
+                    __file__,
+                    "--bare-client" if bare else "--online-client",
+                    address,
+                    f"team{i}",
+                    str(steps),
+                ],
                 stdout=subprocess.PIPE,
             )
             for i in range(teams)
@@ -363,9 +394,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--online-client", nargs=3, metavar=("ADDRESS", "TEAM", "STEPS"), help=argparse.SUPPRESS
     )
+    p.add_argument(
+        "--bare-client", nargs=3, metavar=("ADDRESS", "TEAM", "STEPS"), help=argparse.SUPPRESS
+    )
     args = p.parse_args(argv)
     if args.online_client:
         online_client(args.online_client[0], args.online_client[1], int(args.online_client[2]))
+        return 0
+    if args.bare_client:
+        bare_client(args.bare_client[0], args.bare_client[1], int(args.bare_client[2]))
         return 0
     steps, rounds = (200, 2) if args.quick else (900, 7)
     rows: list[dict[str, object]] = []
@@ -420,6 +457,10 @@ def main(argv: list[str] | None = None) -> int:
         }
     )
 
+    bare = online(2, 300 if args.quick else 3000, bare=True)
+    print(
+        f"2 teams, messaging alone (no simulation) {bare:9,.0f} steps/s  (the lockstep's ceiling)"
+    )
     for teams in (2, 8, 16):
         rate = online(teams, 300 if args.quick else 2000)
         target = 2000 if teams == 2 else None
