@@ -290,7 +290,7 @@ def manual_loop(seconds: float) -> dict[str, float]:
     }
 
 
-def online_client(address: str, name: str, steps: int) -> None:
+def online_client(address: str, name: str, steps: int, cpu: int | None = None) -> None:
     """One team of one c172p flying ``steps`` lockstep steps; prints its steps/s."""
     from gymfg_il import Team
     from gymfg_il.aircraft import c172p
@@ -299,7 +299,7 @@ def online_client(address: str, name: str, steps: int) -> None:
     from gymfg_il.tasks import LevelFlightTask
 
     team = Team(name, [(c172p(f"{name}-1"), LevelFlightTask)], episode_time_s=steps / 10 + 10)
-    env = OnlineEnv(address, timeout_s=60)
+    env = OnlineEnv(address, timeout_s=60, cpu=cpu)
     (obs,), _ = env.reset(team, seed=0)
     assert env.world is not None
     slot = env.world.slots[0]
@@ -334,9 +334,13 @@ def bare_client(address: str, name: str, steps: int) -> None:
     sock.close(0)
 
 
-def online(teams: int, steps: int, bare: bool = False) -> float:
+def online(teams: int, steps: int, bare: bool = False, pinned: bool = False) -> float:
     """Simulation steps/s of ``teams`` client processes in lockstep with a real server
-    (``bare``: clients that only report, the messaging's own ceiling)."""
+    (``bare``: clients that only report, the messaging's own ceiling; ``pinned``: each
+    client on a CPU of its own, ``OnlineEnv(cpu=i)``, as teams on separate machines)."""
+    import os
+
+    cpus = sorted(os.sched_getaffinity(0))
     import socket
     import subprocess
 
@@ -370,6 +374,7 @@ def online(teams: int, steps: int, bare: bool = False) -> float:
                     address,
                     f"team{i}",
                     str(steps),
+                    *([str(cpus[i % len(cpus)])] if pinned else []),
                 ],
                 stdout=subprocess.PIPE,
             )
@@ -392,14 +397,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", type=Path, help="write the rows to this JSON file")
     p.add_argument("--quick", action="store_true", help="fewer, shorter rounds (a smoke run)")
     p.add_argument(
-        "--online-client", nargs=3, metavar=("ADDRESS", "TEAM", "STEPS"), help=argparse.SUPPRESS
+        "--online-client", nargs="+", metavar="ADDRESS TEAM STEPS [CPU]", help=argparse.SUPPRESS
     )
     p.add_argument(
         "--bare-client", nargs=3, metavar=("ADDRESS", "TEAM", "STEPS"), help=argparse.SUPPRESS
     )
     args = p.parse_args(argv)
     if args.online_client:
-        online_client(args.online_client[0], args.online_client[1], int(args.online_client[2]))
+        address, team, steps, *cpu = args.online_client
+        online_client(address, team, int(steps), int(cpu[0]) if cpu else None)
         return 0
     if args.bare_client:
         bare_client(args.bare_client[0], args.bare_client[1], int(args.bare_client[2]))
@@ -460,6 +466,17 @@ def main(argv: list[str] | None = None) -> int:
     bare = online(2, 300 if args.quick else 3000, bare=True)
     print(
         f"2 teams, messaging alone (no simulation) {bare:9,.0f} steps/s  (the lockstep's ceiling)"
+    )
+    pinned = online(2, 300 if args.quick else 2000, pinned=True)
+    print(f"2 teams, each client on its own CPU   {pinned:9,.0f} steps/s  (OnlineEnv(cpu=i))")
+    rows.append(
+        {
+            "name": "online_2_teams_pinned_steps_per_s",
+            "value": pinned,
+            "unit": "steps/s",
+            "target": None,
+            "higher_is_better": True,
+        }
     )
     for teams in (2, 8, 16):
         rate = online(teams, 300 if args.quick else 2000)

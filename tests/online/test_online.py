@@ -13,6 +13,7 @@ import zmq
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from gymfg_il.errors import ConfigError
 from gymfg_il.online.client import OnlineEnv
 from gymfg_il.online.protocol import ServerError, decode, encode
 
@@ -250,3 +251,24 @@ def fuzz_server():
     proc.terminate()
     proc.wait(5)
     assert alive and len(states) == 10
+
+
+def test_a_pinned_client_runs_on_its_cpu_and_refuses_one_it_may_not_use():
+    import threading
+
+    before = os.sched_getaffinity(0)
+    cpu = sorted(before)[-1]
+    seen = {}
+
+    def client():  # in a thread: pinning applies to the calling thread only
+        env = OnlineEnv("tcp://127.0.0.1:1", cpu=cpu)
+        seen["affinity"] = os.sched_getaffinity(0)
+        env.close()
+
+    thread = threading.Thread(target=client)
+    thread.start()
+    thread.join(30)
+    assert seen["affinity"] == {cpu}
+    assert os.sched_getaffinity(0) == before  # the rest of the process is left alone
+    with pytest.raises(ConfigError, match="cpu=4096"):
+        OnlineEnv("tcp://127.0.0.1:1", cpu=4096)
