@@ -77,7 +77,8 @@ def fly_and_label(
             action[:3] += rng.normal(0.0, noise, 3)
             action = np.clip(action, _LOW, _HIGH)
         if teacher is not None and hasattr(teacher, "track"):
-            teacher.track(action)  # the expert's integrators follow what was really flown
+            # the expert's integrators follow what was really flown, or the observed ones
+            teacher.track(action, from_observation=True)
         observations.append(obs)
         obs, reward, terminated, truncated, step_info = env.step(action)
         states.append(slot.state)

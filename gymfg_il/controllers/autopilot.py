@@ -91,23 +91,30 @@ class Autopilot:
         self._last_heading_target: float | None = None
         self._last_altitude_target: float | None = None
         self.throttle_trim = 0.7
+        self._observed = self._observed_integrals()
+        self._from_observation: dict[str, int] = {}
 
     def reset(self, seed: int | None = None) -> None:
         for pid in (self.pitch_pid, self.roll_pid, self.climb_pid, self.speed_pid):
             pid.reset()
+        self._from_observation = {}
         self.start = None
         self._last_heading_target = None
         self._last_altitude_target = None
 
-    def track(self, applied: np.ndarray) -> None:
+    def track(self, applied: np.ndarray, *, from_observation: bool = False) -> None:
         """Follow an action someone else applied (see ``PID.track``): the surface loops'
-        integrals are set so this controller would have output it.
+        integrals are set so this controller would have output it (a bumpless hand-back
+        after a human's takeover).
 
-        A loop whose error integral the observation carries (``roll_deg_error_integral`` for
-        a roll target, ...) keeps its own integral instead: it equals that observed value,
-        so a label from this controller stays a function of the observation, which is
-        what a memoryless policy can learn (DAgger)."""
-        observed = self._observed_integrals
+        ``from_observation`` (labelling under DAgger): a loop whose error integral the
+        observation carries (``roll_deg_error_integral`` for a roll target, ...) takes its
+        integral from the observation at each later ``act`` instead, so the label is a
+        function of the observation alone, which is what a memoryless policy can learn.
+        Back-calculating it from the policy's own action would make the label depend on
+        that action, which the policy never sees."""
+        observed = self._observed if from_observation else {}
+        self._from_observation = observed
         if "roll" not in observed:
             self.roll_pid.track(float(applied[0]))
         if "pitch" not in observed:
@@ -115,17 +122,24 @@ class Autopilot:
         if "speed" not in observed:
             self.speed_pid.track(float(applied[3]))
 
-    @property
-    def _observed_integrals(self) -> set[str]:
-        t, names = self.targets, self.index
-        out = set()
-        if t.lateral == "roll" and "roll_deg_error_integral" in names:
-            out.add("roll")
-        if t.vertical == "pitch" and "pitch_deg_error_integral" in names:
-            out.add("pitch")
-        if isinstance(t.speed_source, str) and "airspeed_kts_error_integral" in names:
-            out.add("speed")
+    def _observed_integrals(self) -> dict[str, int]:
+        """Loop -> index of the observation entry holding its error integral."""
+        t, index = self.targets, self.index
+        out = {}
+        if t.lateral == "roll" and "roll_deg_error_integral" in index:
+            out["roll"] = index["roll_deg_error_integral"]
+        if t.vertical == "pitch" and "pitch_deg_error_integral" in index:
+            out["pitch"] = index["pitch_deg_error_integral"]
+        if isinstance(t.speed_source, str) and "airspeed_kts_error_integral" in index:
+            out["speed"] = index["airspeed_kts_error_integral"]
         return out
+
+    def _load_integral(self, loop: str, pid: PID, obs: np.ndarray, error: float) -> None:
+        """Set ``pid``'s integral so its next update ends at the observed one."""
+        at = self._from_observation.get(loop)
+        if at is not None:
+            limit = (pid.out_max - pid.out_min) / abs(pid.ki)
+            pid.integral = max(-limit, min(limit, float(obs[at]) - error * self.dt))
 
     def set_throttle_trim(self, throttle: float) -> None:
         self.throttle_trim = throttle
@@ -160,6 +174,7 @@ class Autopilot:
             climb_target = max(-g.max_descent_fps, min(g.max_climb_fps, climb_target))
             pitch_target = self.climb_pid(climb_target, obs[i["vertical_speed_fps"]], dt)
         pitch_target = max(-g.max_pitch_deg, min(g.max_pitch_deg, pitch_target))
+        self._load_integral("pitch", self.pitch_pid, obs, pitch_target - obs[i["pitch_deg"]])
         nose_up = self.pitch_pid(pitch_target, obs[i["pitch_deg"]], dt, obs[i["q_rad_s"]] * _R2D)
         # lateral: heading -> roll -> aileron
         if t.lateral == "heading":
@@ -176,9 +191,11 @@ class Autopilot:
             if t.lateral == "heading"
             else roll_target
         )
+        self._load_integral("roll", self.roll_pid, obs, roll_target - obs[i["roll_deg"]])
         aileron = self.roll_pid(roll_target, obs[i["roll_deg"]], dt, obs[i["p_rad_s"]] * _R2D)
         # speed: airspeed -> throttle; rudder: sideslip -> 0
         speed_target = self._value(obs, t.speed_source, "airspeed_kts")
+        self._load_integral("speed", self.speed_pid, obs, speed_target - obs[i["airspeed_kts"]])
         throttle = self.speed_pid(speed_target, obs[i["airspeed_kts"]], dt)
         rudder = max(-1.0, min(1.0, -g.sideslip * obs[i["beta_deg"]]))
         return np.array([aileron, -nose_up, rudder, throttle])

@@ -69,3 +69,23 @@ def test_pid_anti_windup_and_derivative_on_measurement():
         pid(0, 0, 0.0)
     with pytest.raises(ConfigError):
         PID(1.0, out_min=1, out_max=0)
+
+
+def test_labels_from_the_observed_integral_depend_on_the_observation_alone():
+    """Under DAgger the expert's roll loop reads its integral from the observation: two
+    experts that tracked different actions label the same observation alike; a plain track
+    (a human's takeover) keeps the hand-back bumpless instead."""
+    env = AircraftEnv("roll", "c172p", task_kwargs={"target": 20})
+    obs, _ = env.reset(seed=0)
+    nxt, *_ = env.step(np.array([0.1, 0.0, 0.0, 0.7]))
+    env.close()
+    labels, bumpless = [], []
+    for applied in (-0.4, 0.4):
+        for from_observation, out in ((True, labels), (False, bumpless)):
+            pilot = controller_for(env.task, "c172p", env.dt, 0.7)
+            pilot.reset(0)
+            pilot.act(obs)
+            pilot.track(np.array([applied, 0.0, 0.0, 0.7]), from_observation=from_observation)
+            out.append(pilot.act(nxt)[0])
+    assert labels[0] == pytest.approx(labels[1], abs=1e-9)
+    assert bumpless[1] - bumpless[0] == pytest.approx(0.8, abs=1e-6)
