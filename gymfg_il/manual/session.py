@@ -268,8 +268,9 @@ class ManualSession:
         names = env.observation_names
         target = actual = None
         target_name = ""
-        if names[-2].endswith("_target") and self.state != "idle":
-            var = names[-2].removesuffix("_target")
+        target_names = [n for n in names if n.endswith("_target")]
+        if target_names and self.state != "idle":
+            var = target_names[0].removesuffix("_target")
             target_name = f"{var} ({BY_NAME[var].unit})"
             target = env.task.target_value(env.world.steps)
             actual = float(state[INDEX[var]])

@@ -139,3 +139,23 @@ def test_appending_another_task_is_refused(tmp_path):
     roll = EnvSpec("roll", "c172p", episode_time_s=3, agent_hz=30)
     with pytest.raises(ConfigError, match="features differ"):
         ManualSession(roll, tmp_path, realtime=False)
+
+
+def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
+    drawn = []
+
+    def spy(session):
+        draw = session.gui.draw
+        session.gui.draw = lambda frame: (drawn.append(frame), draw(frame))
+
+    def on_frame(frame, session):
+        if frame == 1:
+            spy(session)
+            key(pygame.K_SPACE)
+        if frame == 20:
+            key(pygame.K_q)
+
+    ManualSession(SPEC, tmp_path, realtime=False, on_frame=on_frame).run(max_frames=40)
+    flying = [f for f in drawn if f.status != "idle"]
+    assert flying and all(f.target_name == "altitude_ft (ft)" for f in flying)
+    assert all(abs(f.target - f.actual) <= 1000 for f in flying)
