@@ -82,10 +82,13 @@ class Simulation:
         ]
         self._mixtures = [f"fcs/mixture-cmd-norm[{i}]" for i in range(self.engines)]
         self._has_gear = pm.hasNode("gear/gear-cmd-norm")
+        # JSBSim gives a gear unit a pos-norm only when it retracts (the c172p's does not)
+        units = fdm.get_ground_reactions().get_num_gear_units()
+        self._retracts = any(pm.hasNode(f"gear/unit[{i}]/pos-norm") for i in range(units))
         self._run = fdm.run
         self._substep_range = range(self.substeps)
         self.resets = 0
-        if self._has_gear:
+        if self._retracts:
             self._retract_gear()
 
     @property
@@ -123,10 +126,9 @@ class Simulation:
         at build time makes every episode start alike.
         """
         self.reset(InitialConditions(altitude_ft=30000.0, airspeed_kts=250.0))
-        for frame in range(60 * self.sim_hz):
-            position = self.fdm["gear/gear-pos-norm"]
-            if position <= 0.0 or (frame == self.sim_hz and position >= 1.0):
-                break  # stowed, or fixed gear (it has not moved in a second): nothing to do
+        for _ in range(60 * self.sim_hz):
+            if self.fdm["gear/gear-pos-norm"] <= 0.0:
+                break
             self._run()
         self.resets = 0
 
