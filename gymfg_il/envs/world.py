@@ -218,6 +218,9 @@ class World:
 
             self.traffic[callsign] = TrafficSender(list(ports))
         self._pose_idx = indices(POSITION + ORIENTATION)
+        # aircraft simulated elsewhere (an online client's opponents): callsign -> lat, lon,
+        # altitude, roll, pitch, heading, for the views' traffic
+        self.others: dict[str, np.ndarray] = {}
         self._next_frame = 0.0
         self.steps = 0
         self.started = False
@@ -272,6 +275,7 @@ class World:
         unknown = set(ics) - set(self.by_callsign)
         if unknown:
             raise ConfigError(f"initial conditions given for unknown callsigns {sorted(unknown)}")
+        self.others.clear()  # last episode's opponents are not shown at this one's start
         for slot in self.slots:
             own = np.random.default_rng([base, 1 + zlib.crc32(slot.callsign.encode())])
             ic = ics.get(slot.callsign) or slot.task.initial_conditions(own)
@@ -325,13 +329,11 @@ class World:
 
     def _send_traffic(self) -> None:
         poses = [(s.callsign, s.aircraft.model, s.state[self._pose_idx]) for s in self.slots]
-        for callsign, view in self.external.items():  # an online client's opponents
-            if all(name in view for name in POSITION + ORIENTATION):
-                pose = [view[name] for name in POSITION + ORIENTATION]
-                poses.append((callsign, "", pose))  # model unknown: FlightGear's fallback
+        # an online client's opponents; their model is unknown here: FlightGear's fallback
+        poses += [(callsign, "", pose) for callsign, pose in self.others.items()]
         for viewer, sender in self.traffic.items():
             for callsign, model, pose in poses:
-                if callsign != viewer:
+                if callsign != viewer and np.isfinite(pose).all():
                     sender.send(callsign, model, pose)
 
     def score(self) -> None:

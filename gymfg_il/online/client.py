@@ -10,6 +10,7 @@ others.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -20,6 +21,7 @@ from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import EnvConfig, SimPool, World
 from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.online.protocol import ProtocolError, ServerError, decode, encode
+from gymfg_il.sim.properties import ORIENTATION, POSITION
 
 
 class OnlineEnv:
@@ -59,30 +61,35 @@ class OnlineEnv:
     ) -> None:
         import zmq
 
-        if cpu is not None:
-            import os
-
-            available = sorted(os.sched_getaffinity(0))
-            if cpu not in available:
-                raise ConfigError(f"cpu={cpu!r}: this process may run on CPUs {available}")
-            os.sched_setaffinity(0, {cpu})  # this thread, and the I/O thread started below
         self.address, self.token, self.timeout_s = address, token, timeout_s
         self.config = EnvConfig(sim_hz, agent_hz, views=views, traffic=traffic)
-        self._pool = SimPool(sim_hz, agent_hz)
+        self._affinity: set[int] | None = None  # the calling thread's, while pinned
+        if cpu is not None:
+            available = os.sched_getaffinity(0)
+            if cpu not in available:
+                raise ConfigError(f"cpu={cpu!r}: this process may run on CPUs {sorted(available)}")
+            self._affinity = available
+            os.sched_setaffinity(0, {cpu})  # this thread, and the I/O thread started below
         # a pinned client starts its own context, so its I/O thread starts pinned too
         self._own_ctx = cpu is not None
         self.ctx: Any = zmq.Context() if self._own_ctx else zmq.Context.instance()
-        self.sock = self.ctx.socket(zmq.DEALER)
-        self.sock.setsockopt(zmq.LINGER, 0)
-        self.sock.setsockopt(zmq.RCVTIMEO, int(timeout_s * 1000))
-        if server_key is not None:
-            public, secret = zmq.curve_keypair()
-            self.sock.curve_publickey, self.sock.curve_secretkey = public, secret
-            self.sock.curve_serverkey = server_key
-        self.sock.connect(address)
+        try:
+            self.sock = self.ctx.socket(zmq.DEALER)
+            self.sock.setsockopt(zmq.LINGER, 0)
+            self.sock.setsockopt(zmq.RCVTIMEO, int(timeout_s * 1000))
+            if server_key is not None:
+                public, secret = zmq.curve_keypair()
+                self.sock.curve_publickey, self.sock.curve_secretkey = public, secret
+                self.sock.curve_serverkey = server_key
+            self.sock.connect(address)
+        except Exception:
+            self._release()
+            raise
+        self._pool = SimPool(sim_hz, agent_hz)
         self.world: World | None = None
         self.team: Team | None = None
         self.view: tuple[str, ...] = ()
+        self._pose_at: list[int] | None = None
         self.joined = False
         self._rng = np.random.default_rng()
         self._done = True
@@ -134,6 +141,11 @@ class OnlineEnv:
         rows = central["opponents"]
         self.opponents = [r[0] for r in rows]
         assert self.world is not None
+        if self._pose_at is not None and self.world.traffic:  # shown in the team's views
+            others = self.world.others
+            others.clear()
+            for callsign, _, values in rows:
+                others[callsign] = np.asarray(values, dtype=np.float64)[self._pose_at]
         for callsign, _, values in rows:
             view = self.world.external.get(callsign)
             if view is not None:
@@ -164,6 +176,10 @@ class OnlineEnv:
                 "welcome",
             )
             self.view = tuple(welcome["opponent_view"])
+            pose = POSITION + ORIENTATION
+            self._pose_at = (
+                [self.view.index(n) for n in pose] if set(pose) <= set(self.view) else None
+            )
             self.joined = True
         if seed is not None:
             self._rng = np.random.default_rng(seed)
@@ -186,10 +202,12 @@ class OnlineEnv:
         # Rewards and observations need the other teams only when a reward targets them:
         # otherwise they are computed while the server gathers the other reports.
         early = not world.external
-        if early:
-            world.score()
-            observations = [world.observation(s) for s in world.slots]
-        central = self._receive("central")
+        try:
+            if early:
+                world.score()
+                observations = [world.observation(s) for s in world.slots]
+        finally:  # even when scoring fails, this tick's reply must not be left unread
+            central = self._receive("central")
         opponents = self._opponents(central)
         if not early:
             world.score()
@@ -222,13 +240,24 @@ class OnlineEnv:
             self.sock.send(encode({"type": "leave", "team": self.team.name, "token": self.token}))
             self.joined = False
 
+    def _release(self) -> None:
+        """End a pinned client's own context and give the thread its CPUs back."""
+        if self._own_ctx:
+            sock = getattr(self, "sock", None)
+            if sock is not None:
+                sock.close(0)
+            self.ctx.term()
+            self._own_ctx = False
+        if self._affinity is not None:
+            os.sched_setaffinity(0, self._affinity)
+            self._affinity = None
+
     def close(self) -> None:
         try:
             self.leave()
         finally:
             self.sock.close(0)
-            if self._own_ctx:
-                self.ctx.term()
+            self._release()
             if self.world is not None:
                 self.world.close()
                 self.world = None

@@ -2,6 +2,7 @@
 
 import os
 import socket
+import struct
 import subprocess
 import sys
 import time
@@ -265,10 +266,51 @@ def test_a_pinned_client_runs_on_its_cpu_and_refuses_one_it_may_not_use():
         seen["affinity"] = os.sched_getaffinity(0)
         env.close()
 
-    thread = threading.Thread(target=client)
+    def pinned_then_closed():
+        client()
+        seen["after"] = os.sched_getaffinity(0)
+
+    thread = threading.Thread(target=pinned_then_closed)
     thread.start()
     thread.join(30)
     assert seen["affinity"] == {cpu}
+    assert seen["after"] == before  # close() gives the thread its CPUs back
     assert os.sched_getaffinity(0) == before  # the rest of the process is left alone
     with pytest.raises(ConfigError, match="cpu=4096"):
         OnlineEnv("tcp://127.0.0.1:1", cpu=4096)
+
+
+def test_a_teams_views_show_its_opponents_as_traffic(server, tmp_path):
+    """Every opponent the server lets the team see reaches the team's FlightGear view as
+    multiplayer traffic, with the position the team received; the viewer itself does not."""
+    from gymfg_il.viz import multiplayer as mp
+
+    address, _ = server("--mode", "fixed", "--teams", "2")
+    rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    for port in range(23000, 32000):
+        try:
+            rx.bind(("127.0.0.1", port))
+            break
+        except OSError:
+            continue
+    rx.settimeout(10)
+    blue = client(address, "", "blue", 0, 3, tmp_path / "blue.npy")
+    env = OnlineEnv(address, timeout_s=20, traffic={"red-1": [rx.getsockname()[1]]})
+    _, opponents = env.reset(run_team.teams(3)["red"], seed=0)
+    for _ in range(5):
+        _, opponents, *_ = env.step(np.zeros(8))
+    env.close()
+    blue.wait(30)
+    packets = {}
+    rx.setblocking(False)
+    while True:
+        try:
+            data = rx.recv(1024)
+        except BlockingIOError:
+            break
+        callsign = mp.HEADER.unpack_from(data)[-1].rstrip(b"\0").decode()
+        packets[callsign] = struct.unpack_from(">3d", data, mp.HEADER.size + 96 + 16)
+    rx.close()
+    assert set(packets) == {"red-2", "blue-1"}  # teammate and opponent, not the viewer
+    lat, lon, alt = opponents[0][:3]  # what the team saw of blue-1 (the view before the end)
+    assert np.allclose(packets["blue-1"], mp.ecef(lat, lon, alt), atol=200)
