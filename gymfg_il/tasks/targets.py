@@ -113,6 +113,7 @@ class TargetTask(Task):
         self.start_value = 0.0
         self._integral = 0.0
         self._integral_step = -1
+        self._integral_limit = self._span() * INTEGRAL_LIMIT_S
 
     @property
     def observation_vars(self) -> tuple[str, ...]:  # type: ignore[override]
@@ -126,8 +127,7 @@ class TargetTask(Task):
     def _extra_bounds(self) -> tuple[list[float], list[float]]:
         var = BY_NAME[self.family.variable]
         span = self._span()
-        limit = span * INTEGRAL_LIMIT_S
-        return [var.low, -span, -limit], [var.high, span, limit]
+        return [var.low, -span, -self._integral_limit], [var.high, span, self._integral_limit]
 
     def _span(self) -> float:
         var = BY_NAME[self.family.variable]
@@ -187,7 +187,7 @@ class TargetTask(Task):
             err = (err + 180.0) % 360.0 - 180.0
         if step > self._integral_step:  # once per step, however often it is observed
             missed = step - self._integral_step if self._integral_step >= 0 else 1
-            limit = self._span() * INTEGRAL_LIMIT_S
+            limit = self._integral_limit
             self._integral = max(-limit, min(limit, self._integral + err * self.dt * missed))
             self._integral_step = step
         obs[n] = target
