@@ -37,9 +37,10 @@ class OnlineEnv:
         views, traffic: FlightGear views of the team's aircraft, as in ``OfflineEnv``; the
             opponents appear in them as multiplayer traffic (from what the server lets the
             team see of them).
-        cpu: run this client and ZeroMQ's I/O thread on this one CPU. Where several teams
-            share a machine, one CPU each saves a cross-CPU wake-up at every message (on the
-            2-core benchmark VM, two pinned teams step about 15% faster).
+        cpu: run this client and ZeroMQ's I/O thread on this one CPU (the thread's CPUs
+            come back at ``close``). Where several teams share a machine, one CPU each saves
+            a cross-CPU wake-up at every message: on the 2-core benchmark VM the median of
+            interleaved runs rose 5-15%, less than that VM's run-to-run swing.
 
     ``reset`` and ``step`` return what ``OfflineEnv`` returns; ``truncated`` also becomes True
     when the server ends the simulation (in a k-fixed simulation, when any team completes),
