@@ -177,6 +177,9 @@ class OnlineEnv:
                 "welcome",
             )
             self.view = tuple(welcome["opponent_view"])
+            if self.view != tuple(self.config.opponent_view):  # the server decides
+                for view in self.world.external.values():
+                    view.rename(self.view)
             pose = POSITION + ORIENTATION
             self._pose_at = (
                 [self.view.index(n) for n in pose] if set(pose) <= set(self.view) else None

@@ -135,6 +135,12 @@ class StateView:
     def names(self) -> tuple[str, ...]:
         return tuple(self._index)
 
+    def rename(self, names: tuple[str, ...]) -> None:
+        """Hold a vector of other variables from now on (NaN until filled): an online
+        client learns the opponent view from the server only when it joins."""
+        self._index = {n: i for i, n in enumerate(names)}
+        self.values = np.full(len(names), np.nan)
+
     def as_dict(self) -> dict[str, float]:
         return {n: float(self.values[i]) for n, i in self._index.items()}
 

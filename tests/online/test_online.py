@@ -314,3 +314,49 @@ def test_a_teams_views_show_its_opponents_as_traffic(server, tmp_path):
     assert set(packets) == {"red-2", "blue-1"}  # teammate and opponent, not the viewer
     lat, lon, alt = opponents[0][:3]  # what the team saw of blue-1 (the view before the end)
     assert np.allclose(packets["blue-1"], mp.ecef(lat, lon, alt), atol=200)
+
+
+def test_reward_targets_read_the_view_the_server_announces(server):
+    """A reward that reads an opponent sees the variables the server sends, by name, even
+    when the server's view is not the default one."""
+    import threading
+    from functools import partial
+
+    from gymfg_il import Team
+    from gymfg_il.aircraft import c172p
+    from gymfg_il.sim.properties import INDEX
+    from gymfg_il.tasks import DummyTask
+
+    address, _ = server("--mode", "open", "--view", "heading_deg", "airspeed_kts")
+    blue = zmq.Context.instance().socket(zmq.DEALER)
+    blue.connect(address)
+    blue.send(encode({"type": "join", "team": "blue", "aircraft": {"blue-1": "c172p"}}))
+    assert decode(blue.recv(), "server")["type"] == "welcome"
+    state = [0.0] * 26
+    state[INDEX["heading_deg"]], state[INDEX["airspeed_kts"]] = 123.0, 98.0
+
+    done = threading.Event()
+    blue.setsockopt(zmq.RCVTIMEO, 10000)
+
+    def fly_blue():  # reports until red has flown, so red always meets it in the lockstep
+        while not done.is_set():
+            blue.send(encode({"type": "report", "team": "blue", "states": {"blue-1": state}}))
+            decode(blue.recv(), "server")
+
+    thread = threading.Thread(target=fly_blue)
+    thread.start()
+    seen = []
+    task = partial(
+        DummyTask, reward=lambda ctx: seen.append(ctx.targets["blue-1"]["airspeed_kts"]) or 0.0
+    )
+    red_one = c172p("red-1")
+    red = Team("red", [(red_one, task)], reward_function_targets={red_one: [c172p("blue-1")]})
+    env = OnlineEnv(address, timeout_s=20)
+    env.reset(red, seed=0)
+    for _ in range(2):
+        env.step(np.zeros(4))
+    done.set()
+    env.close()
+    thread.join(20)
+    blue.close(0)
+    assert seen == [98.0, 98.0]
