@@ -413,9 +413,17 @@ def main(argv: list[str] | None = None) -> int:
     steps, rounds = (200, 2) if args.quick else (900, 7)
     rows: list[dict[str, object]] = []
 
-    def row(name: str, value: float, unit: str, target: float) -> None:
+    def row(
+        name: str, value: float, unit: str, target: float | None, higher_is_better: bool = True
+    ) -> None:
         rows.append(
-            {"name": name, "value": value, "unit": unit, "target": target, "higher_is_better": True}
+            {
+                "name": name,
+                "value": value,
+                "unit": unit,
+                "target": target,
+                "higher_is_better": higher_is_better,
+            }
         )
 
     r = env_vs_raw(steps, rounds)
@@ -453,15 +461,7 @@ def main(argv: list[str] | None = None) -> int:
         f"{r['median']:.2f} ms"
     )
     print(f"manual_loop_p99_period_error_ms  {r['p99']:11.2f} ms  (target < 5)\n")
-    rows.append(
-        {
-            "name": "manual_loop_p99_period_error_ms",
-            "value": r["p99"],
-            "unit": "ms",
-            "target": 5.0,
-            "higher_is_better": False,
-        }
-    )
+    row("manual_loop_p99_period_error_ms", r["p99"], "ms", 5.0, higher_is_better=False)
 
     bare = online(2, 300 if args.quick else 3000, bare=True)
     print(
@@ -469,29 +469,13 @@ def main(argv: list[str] | None = None) -> int:
     )
     pinned = online(2, 300 if args.quick else 2000, pinned=True)
     print(f"2 teams, each client on its own CPU   {pinned:9,.0f} steps/s  (OnlineEnv(cpu=i))")
-    rows.append(
-        {
-            "name": "online_2_teams_pinned_steps_per_s",
-            "value": pinned,
-            "unit": "steps/s",
-            "target": None,
-            "higher_is_better": True,
-        }
-    )
+    row("online_2_teams_pinned_steps_per_s", pinned, "steps/s", None)
     for teams in (2, 8, 16):
         rate = online(teams, 300 if args.quick else 2000)
         target = 2000 if teams == 2 else None
         note = "(target >= 2,000)" if target else "(reported)"
         print(f"online_{teams}_teams_steps_per_s {rate:13,.0f} steps/s  {note}")
-        rows.append(
-            {
-                "name": f"online_{teams}_teams_steps_per_s",
-                "value": rate,
-                "unit": "steps/s",
-                "target": target,
-                "higher_is_better": True,
-            }
-        )
+        row(f"online_{teams}_teams_steps_per_s", rate, "steps/s", target)
     print()
 
     sample = Path(__file__).resolve().parents[1] / "datasets/sample-altitude-c172p/dataset"

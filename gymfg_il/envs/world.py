@@ -68,19 +68,16 @@ class EnvConfig:
 
     def __post_init__(self) -> None:
         substeps(self.sim_hz, self.agent_hz)
-        from gymfg_il.viz.multiplayer import MAX_PORT
+        from gymfg_il.viz.multiplayer import port_problem
 
-        bad = [
-            (c, p)
+        problems = [
+            f"traffic of {c!r}: {problem}"
             for c, ports in (self.traffic or {}).items()
-            for p in ports
-            if not (isinstance(p, int) and 0 < p <= MAX_PORT)
+            for problem in map(port_problem, ports)
+            if problem
         ]
-        if bad:
-            raise ConfigError(
-                f"traffic ports {bad}: FlightGear 2020.3 keeps multiplayer ports in a signed "
-                f"16-bit property; give each view a port in 1..{MAX_PORT}"
-            )
+        if problems:
+            raise ConfigError("; ".join(problems))
         view = tuple(self.opponent_view)
         object.__setattr__(self, "opponent_view", view)
         indices(view)

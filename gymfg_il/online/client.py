@@ -84,6 +84,8 @@ class OnlineEnv:
                 self.sock.curve_serverkey = server_key
             self.sock.connect(address)
         except Exception:
+            if hasattr(self, "sock"):
+                self.sock.close(0)
             self._release()
             raise
         self._pool = SimPool(sim_hz, agent_hz)
@@ -247,10 +249,7 @@ class OnlineEnv:
     def _release(self) -> None:
         """End a pinned client's own context and give the thread its CPUs back."""
         if self._own_ctx:
-            sock = getattr(self, "sock", None)
-            if sock is not None:
-                sock.close(0)
-            self.ctx.term()
+            self.ctx.term()  # its socket is closed by now
             self._own_ctx = False
         if self._affinity is not None:
             os.sched_setaffinity(0, self._affinity)

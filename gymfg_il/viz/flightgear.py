@@ -72,13 +72,11 @@ class FlightGear:
         multiplayer_port: int | None = None,
         extra: tuple[str, ...] = (),
     ) -> None:
-        from gymfg_il.viz.multiplayer import MAX_PORT
+        from gymfg_il.viz.multiplayer import port_problem
 
-        if multiplayer_port is not None and not 0 < multiplayer_port <= MAX_PORT:
-            raise FlightGearError(
-                f"multiplayer_port={multiplayer_port}: FlightGear 2020.3 stores multiplayer "
-                f"ports as signed 16-bit numbers; pick one in 1..{MAX_PORT}"
-            )
+        problem = None if multiplayer_port is None else port_problem(multiplayer_port)
+        if problem:
+            raise FlightGearError(problem)
         exe = find_fgfs()
         if exe is None:
             raise FlightGearError(

@@ -24,6 +24,8 @@ import struct
 import time
 from collections.abc import Sequence
 
+from gymfg_il.errors import ConfigError
+
 MAGIC = 0x46474653  # "FGFS"
 PROTOCOL = 0x00010001
 POSITION_MESSAGE = 7
@@ -34,6 +36,17 @@ SIZE = HEADER.size + BODY.size
 assert SIZE == 232, SIZE
 # FlightGear 2020.3 keeps its multiplayer ports in a signed 16-bit property
 MAX_PORT = 32767
+
+
+def port_problem(port: object) -> str | None:
+    """Why FlightGear cannot listen for traffic on ``port``, or None when it can."""
+    if isinstance(port, int) and not isinstance(port, bool) and 0 < port <= MAX_PORT:
+        return None
+    return (
+        f"multiplayer port {port!r}: FlightGear 2020.3 keeps multiplayer ports in a signed "
+        f"16-bit property; pick one in 1..{MAX_PORT}"
+    )
+
 
 # FlightGear models for JSBSim models without a FlightGear aircraft of their own: the AI
 # models that ship with FlightGear's base data
@@ -157,12 +170,9 @@ class TrafficSender:
     """Sends aircraft as multiplayer traffic to the multiplayer ports of some views."""
 
     def __init__(self, ports: Sequence[int], host: str = "127.0.0.1") -> None:
-        for port in ports:
-            if not 0 < int(port) <= MAX_PORT:
-                raise ValueError(
-                    f"multiplayer port {port}: FlightGear 2020.3 keeps multiplayer ports in a "
-                    f"signed 16-bit property; pick one in 1..{MAX_PORT}"
-                )
+        problems = [p for p in map(port_problem, ports) if p]
+        if problems:
+            raise ConfigError("; ".join(problems))
         self.targets = [(host, int(port)) for port in ports]
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sent = 0
