@@ -57,9 +57,9 @@ def fly(env, team, seed, on_step=None):
 if __name__ == "__main__":
     from gymfg_il.online.client import OnlineEnv
 
-    address, token, name, seed, seconds, out = sys.argv[1:7]
+    address, token, name, seed, seconds, out, *spin = sys.argv[1:8]
     team = teams(float(seconds))[name]
-    env = OnlineEnv(address, token=token, timeout_s=20)
+    env = OnlineEnv(address, token=token, timeout_s=20, spin_us=float(spin[0]) if spin else 1000)
     states, info = fly(env, team, int(seed), lambda n: print(f"step {n}", flush=True))
     np.save(out, states)
     print(f"done {len(states)} {info['server_reason']}", flush=True)

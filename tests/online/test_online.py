@@ -55,7 +55,7 @@ def server(request):
         proc.wait(5)
 
 
-def client(address, token, team, seed, seconds, out):
+def client(address, token, team, seed, seconds, out, spin_us=1000):
     return subprocess.Popen(
         [
             sys.executable,
@@ -66,6 +66,7 @@ def client(address, token, team, seed, seconds, out):
             str(seed),
             str(seconds),
             str(out),
+            str(spin_us),
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
@@ -75,8 +76,9 @@ def client(address, token, team, seed, seconds, out):
 
 def test_online_run_matches_the_offline_env_bit_for_bit(server, tmp_path):
     address, _ = server("--mode", "fixed", "--teams", "2", "--secret", "s")
+    # red polls for the server's replies (the default), blue sleeps on them at once
     red = client(address, "s", "red", 5, 6, tmp_path / "red.npy")
-    blue = client(address, "s", "blue", 5, 6, tmp_path / "blue.npy")
+    blue = client(address, "s", "blue", 5, 6, tmp_path / "blue.npy", spin_us=0)
     for proc in (red, blue):
         out = proc.communicate(timeout=60)[0].decode()
         assert proc.returncode == 0, out
@@ -278,6 +280,12 @@ def test_a_pinned_client_runs_on_its_cpu_and_refuses_one_it_may_not_use():
     assert os.sched_getaffinity(0) == before  # the rest of the process is left alone
     with pytest.raises(ConfigError, match="cpu=4096"):
         OnlineEnv("tcp://127.0.0.1:1", cpu=4096)
+
+
+@pytest.mark.parametrize("spin_us", [-1.0, float("nan"), float("inf"), "fast"])
+def test_a_bad_polling_time_is_refused_by_name(spin_us):
+    with pytest.raises(ConfigError, match=f"spin_us={spin_us!r}"):
+        OnlineEnv("tcp://127.0.0.1:1", spin_us=spin_us)
 
 
 def test_a_teams_views_show_its_opponents_as_traffic(server, tmp_path):
