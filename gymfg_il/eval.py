@@ -87,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from gymfg_il.errors import GymFGError
     from gymfg_il.evaluation.metrics import summarize
-    from gymfg_il.evaluation.parallel import AgentSpec, EnvSpec, fly_many
+    from gymfg_il.evaluation.parallel import AgentSpec, EnvSpec, Workers, fly_many
     from gymfg_il.evaluation.report import table
     from gymfg_il.evaluation.rollout import PRIMARY_CONTROL
     from gymfg_il.policies.agent import PolicyAgent
@@ -117,6 +117,8 @@ def main(argv: list[str] | None = None) -> int:
     seeds = list(range(args.seed, args.seed + args.episodes))
     task_name = spec.task + ("-dynamic" if spec.dynamic else "")
     rows, flown = [], {}
+    # one pool for every agent, started before the progress bar starts its thread
+    workers = Workers(min(args.workers, len(seeds)))
     bar = tqdm(
         total=len(agents) * len(seeds),
         desc="episodes",
@@ -124,10 +126,11 @@ def main(argv: list[str] | None = None) -> int:
         disable=args.no_progress,
         file=sys.stderr,
     )
-    for name, agent in agents.items():
-        bar.set_postfix_str(name)
-        flown[name] = fly_many(spec, agent, seeds, args.workers, progress=lambda: bar.update(1))
-        rows.append(summarize(name, task_name, model, flown[name]))
+    with workers:
+        for name, agent in agents.items():
+            bar.set_postfix_str(name)
+            flown[name] = fly_many(spec, agent, seeds, workers, progress=lambda: bar.update(1))
+            rows.append(summarize(name, task_name, model, flown[name]))
     bar.close()
     add_ratios(rows)
     print(

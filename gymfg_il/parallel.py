@@ -2,7 +2,10 @@
 
 Every episode depends only on its seed (the env is reset with it, the agent too), so seeds can
 be dealt to workers in any way; results come back in seed order. Workers build their own env
-and agents from picklable specs (``EnvSpec``, ``AgentSpec``).
+and agents from picklable specs (``EnvSpec``, ``AgentSpec``) and keep them between episodes.
+
+``map_seeds(..., workers=2)`` starts a pool for the call; ``with Workers(2) as workers:``
+keeps one for several calls (evaluating several agents, rounds of episodes).
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from gymfg_il.envs.single import AircraftEnv
+from gymfg_il.errors import ConfigError
 
 T = TypeVar("T")
 
@@ -57,6 +61,14 @@ class AgentSpec:
     @classmethod
     def policy(cls, path: Path) -> AgentSpec:
         return cls("policy", Path(path))
+
+    def key(self) -> str:
+        """What a worker's cache knows this agent by: its spec, and for a checkpoint the
+        time its files last changed (one retrained in place is loaded afresh)."""
+        if self.path is None or not self.path.is_dir():
+            return repr(self)
+        stamps = sorted((f.name, f.stat().st_mtime_ns) for f in self.path.iterdir())
+        return repr((self, stamps))
 
     def meta(self) -> dict[str, Any]:
         from gymfg_il.policies.factory import read_config
@@ -111,20 +123,64 @@ def _call[T](job: tuple[Callable[..., T], tuple[Any, ...]]) -> T:
     return fn(*args)
 
 
-def map_seeds[T](
-    fn: Callable[..., T], args: tuple[Any, ...], seeds: Sequence[int], workers: int = 1
-) -> Iterator[T]:
-    """``fn(*args, seed)`` for every seed, yielded in seed order, on ``workers`` processes.
+class Workers:
+    """Worker processes kept for several ``map_seeds`` calls; ``close()`` (or the end of a
+    ``with`` block) stops them.
 
-    ``fn`` must be a module-level function (it is pickled by name)."""
-    seeds = list(seeds)
-    if workers <= 1 or len(seeds) <= 1:
-        for seed in seeds:
-            yield fn(*args, seed)
-        return
-    ctx = mp.get_context(_start_method())
-    with ctx.Pool(min(workers, len(seeds)), initializer=_worker_init) as pool:
+    A new worker costs more than its start: its first episode builds the env and agent and
+    touches memory it shares with its parent, each page then copied for it. On the 2-core
+    benchmark VM a fresh 2-worker pool added ~120 ms to 16 episodes of ~110 ms each, so
+    work that comes in several calls (eval's agents, benchmark rounds) shares one pool.
+    The pool starts here, before the caller starts threads (a progress bar's monitor) that
+    would rule out the fast ``fork`` start.
+    """
+
+    def __init__(self, n: int) -> None:
+        if not (isinstance(n, int) and n >= 1):
+            raise ConfigError(f"workers={n!r}: give 1 or more worker processes")
+        self.n = n
+        ctx = mp.get_context(_start_method())
+        self._pool: Any = ctx.Pool(n, initializer=_worker_init) if n > 1 else None
+
+    def imap[T](self, fn: Callable[..., T], args: tuple[Any, ...], seeds: list[int]) -> Iterator[T]:
+        if self._pool is None:
+            raise ConfigError("these Workers are closed (or were made with n=1)")
         jobs = [(fn, (*args, seed)) for seed in seeds]
         # one episode per task: a task costs ~0.1 ms to send, an episode ~100 ms to fly, and
         # the last worker to finish then waits at most one episode
-        yield from pool.imap(_call, jobs, chunksize=1)
+        return self._pool.imap(_call, jobs, chunksize=1)
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.terminate()
+            self._pool.join()
+            self._pool = None
+
+    def __enter__(self) -> Workers:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def map_seeds[T](
+    fn: Callable[..., T],
+    args: tuple[Any, ...],
+    seeds: Sequence[int],
+    workers: int | Workers = 1,
+) -> Iterator[T]:
+    """``fn(*args, seed)`` for every seed, yielded in seed order, on ``workers`` processes
+    (a number: a pool for this call; ``Workers``: that pool, left running).
+
+    ``fn`` must be a module-level function (it is pickled by name)."""
+    seeds = list(seeds)
+    n = workers.n if isinstance(workers, Workers) else workers
+    if n <= 1 or len(seeds) <= 1:
+        for seed in seeds:
+            yield fn(*args, seed)
+        return
+    if isinstance(workers, Workers):
+        yield from workers.imap(fn, args, seeds)
+        return
+    with Workers(min(n, len(seeds))) as pool:
+        yield from pool.imap(fn, args, seeds)

@@ -1,7 +1,13 @@
+import os
+import threading
+
+import pytest
+
 from gymfg_il.collectors.autopilot import record_autopilot
 from gymfg_il.collectors.config import CollectConfig
+from gymfg_il.errors import ConfigError
 from gymfg_il.evaluation.parallel import fly_many
-from gymfg_il.parallel import AgentSpec, EnvSpec
+from gymfg_il.parallel import AgentSpec, EnvSpec, Workers
 from gymfg_il.recording.reader import read_log
 
 
@@ -21,3 +27,26 @@ def test_two_workers_give_what_one_gives(tmp_path):
     for a, b in zip(logs[0].complete_episodes, logs[1].complete_episodes, strict=True):
         sa, sb = a.steps["ego"], b.steps["ego"]
         assert (sa.state == sb.state).all() and (sa.action == sb.action).all()
+
+
+def test_kept_workers_serve_several_calls_alike_and_see_a_retrained_checkpoint(tmp_path):
+    spec = EnvSpec("roll", "c172p", episode_time_s=5)
+    one = fly_many(spec, AgentSpec.controller(), [1, 2, 3], workers=1)
+    with Workers(2) as workers:
+        assert threading.active_count() > 1  # the pool's own threads: it is running
+        first = fly_many(spec, AgentSpec.controller(), [1, 2, 3], workers=workers)
+        again = fly_many(spec, AgentSpec.controller(), [3, 2, 1], workers=workers)
+    for a, b, c in zip(one, first, again[::-1], strict=True):
+        assert (a.actions == b.actions).all() and (a.actions == c.actions).all()
+    with pytest.raises(ConfigError, match="closed"):
+        list(workers.imap(len, (), [1, 2]))
+    with pytest.raises(ConfigError, match="workers=0"):
+        Workers(0)
+
+    # a worker's cache knows a checkpoint by its files: rewritten in place, it is reloaded
+    ckpt = tmp_path / "policy"
+    ckpt.mkdir()
+    (ckpt / "model.safetensors").write_bytes(b"v1")
+    before = AgentSpec.policy(ckpt).key()
+    os.utime(ckpt / "model.safetensors", ns=(1, 1))
+    assert AgentSpec.policy(ckpt).key() != before

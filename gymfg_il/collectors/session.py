@@ -53,7 +53,7 @@ def fly_and_label(
 ) -> FlownEpisode:
     """Fly one episode: ``actor`` chooses (plus Gaussian noise on the surfaces), ``expert``
     labels each visited state (the actor's own clean action when there is no expert)."""
-    key = repr((env_spec, actor, expert))
+    key = repr((env_spec, actor.key(), expert.key() if expert else None))
     if key not in _cache:
         env = env_spec.make()
         _cache[key] = (env, actor.make(env), expert.make(env) if expert else None)

@@ -6,14 +6,14 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from gymfg_il.evaluation.rollout import Episode, fly_episode
-from gymfg_il.parallel import AgentSpec, EnvSpec, map_seeds
+from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, map_seeds
 
 _cache: dict[str, tuple[Any, Any]] = {}
 
 
 def _fly(env_spec: EnvSpec, agent_spec: AgentSpec, seed: int) -> Episode:
     # Workers keep their env and agent between seeds (each episode is reset by its seed).
-    key = repr((env_spec, agent_spec))
+    key = repr((env_spec, agent_spec.key()))
     if key not in _cache:
         env = env_spec.make()
         _cache[key] = (env, agent_spec.make(env))
@@ -25,7 +25,7 @@ def fly_many(
     env_spec: EnvSpec,
     agent_spec: AgentSpec,
     seeds: Sequence[int],
-    workers: int = 1,
+    workers: int | Workers = 1,
     progress: Callable[[], None] | None = None,
 ) -> list[Episode]:
     """One episode per seed, in seed order, on ``workers`` processes."""
@@ -42,4 +42,4 @@ def fly_many(
     return out
 
 
-__all__ = ["AgentSpec", "EnvSpec", "fly_many"]
+__all__ = ["AgentSpec", "EnvSpec", "Workers", "fly_many"]
