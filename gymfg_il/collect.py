@@ -242,8 +242,11 @@ def collect(cfg: object, progress: bool = True, workers: int = 1) -> int:
     from gymfg_il.collectors.commands import report_build
     from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.datasets.from_logs import build_from_logs
+    from gymfg_il.parallel import Workers
 
     assert isinstance(cfg, CollectConfig)
+    # the pool starts before the bar's monitor thread, which would rule out a fork start
+    pool = Workers(min(workers, cfg.episodes))
     bar = tqdm(
         total=cfg.episodes, desc="episodes", unit="ep", disable=not progress, file=sys.stderr
     )
@@ -254,7 +257,8 @@ def collect(cfg: object, progress: bool = True, workers: int = 1) -> int:
         if not progress:  # a line per durable episode, for logs and supervising scripts
             print(f"episode {i} saved (return {ret:.1f})", flush=True)
 
-    result = record_autopilot(cfg, workers=workers, progress=tick)
+    with pool:
+        result = record_autopilot(cfg, workers=pool, progress=tick)
     bar.close()
     print(f"logged {len(result.episodes)} episodes ({result.steps} steps) to {result.log}")
     report = build_from_logs(sorted((cfg.out / LOGS).glob("*.mcap")), cfg.out / DATASET)

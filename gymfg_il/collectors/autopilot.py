@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 from gymfg_il.collectors.config import CollectConfig
 from gymfg_il.collectors.session import DATASET, LOGS, SessionResult, record_session
-from gymfg_il.parallel import AgentSpec, EnvSpec
+from gymfg_il.parallel import AgentSpec, EnvSpec, Workers
 
 __all__ = ["DATASET", "LOGS", "env_spec", "record_autopilot"]
 
@@ -19,7 +19,9 @@ def env_spec(cfg: CollectConfig) -> EnvSpec:
 
 
 def record_autopilot(
-    cfg: CollectConfig, workers: int = 1, progress: Callable[[int, float], None] | None = None
+    cfg: CollectConfig,
+    workers: int | Workers = 1,
+    progress: Callable[[int, float], None] | None = None,
 ) -> SessionResult:
     """Fly ``cfg.episodes`` controller episodes and log them (the dataset is built after)."""
     seeds = range(cfg.seed, cfg.seed + cfg.episodes)

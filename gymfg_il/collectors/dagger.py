@@ -12,7 +12,7 @@ from typing import Any
 
 from gymfg_il.collectors.session import DATASET, LOGS, record_session
 from gymfg_il.errors import ConfigError
-from gymfg_il.parallel import AgentSpec, EnvSpec
+from gymfg_il.parallel import AgentSpec, EnvSpec, Workers
 
 
 @dataclass
@@ -57,31 +57,33 @@ def run_dagger(
     train_args.update(train_overrides or {})
     current = Path(policy)
     history = []
-    for it in range(1, iterations + 1):
-        seeds = range(seed + (it - 1) * episodes, seed + it * episodes)
-        session = record_session(
-            spec,
-            AgentSpec.policy(current),
-            AgentSpec.controller(),
-            seeds,
-            out,
-            "dagger",
-            workers=workers,
-            iteration=it,
-        )
-        report = build_from_logs(sorted((out / LOGS).glob("*.mcap")), root)
-        cfg = TrainConfig(**{**train_args, "dataset": root, "out": out / f"policy-{it}"})
-        result = train_bc(cfg)
-        current = result.out
-        step = DaggerIteration(
-            it,
-            sum(session.returns) / len(session.returns),
-            len(session.episodes),
-            report.total_episodes,
-            current,
-            result.val_loss[-1],
-        )
-        history.append(step)
-        if on_iteration is not None:
-            on_iteration(step)
+    # one pool for every round, forked before training starts threads in this process
+    with Workers(min(workers, episodes)) as pool:
+        for it in range(1, iterations + 1):
+            seeds = range(seed + (it - 1) * episodes, seed + it * episodes)
+            session = record_session(
+                spec,
+                AgentSpec.policy(current),
+                AgentSpec.controller(),
+                seeds,
+                out,
+                "dagger",
+                workers=pool,
+                iteration=it,
+            )
+            report = build_from_logs(sorted((out / LOGS).glob("*.mcap")), root)
+            cfg = TrainConfig(**{**train_args, "dataset": root, "out": out / f"policy-{it}"})
+            result = train_bc(cfg)
+            current = result.out
+            step = DaggerIteration(
+                it,
+                sum(session.returns) / len(session.returns),
+                len(session.episodes),
+                report.total_episodes,
+                current,
+                result.val_loss[-1],
+            )
+            history.append(step)
+            if on_iteration is not None:
+                on_iteration(step)
     return history

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.parallel import AgentSpec, EnvSpec, map_seeds
+from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, map_seeds
 from gymfg_il.recording.writer import TrajectoryWriter
 
 LOGS, DATASET = "logs", "dataset"
@@ -190,7 +190,7 @@ def record_session(
     out: Path,
     source: str,
     noise: float = 0.0,
-    workers: int = 1,
+    workers: int | Workers = 1,
     iteration: int = 0,
     progress: Callable[[int, float], None] | None = None,
 ) -> SessionResult:
