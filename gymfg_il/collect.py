@@ -62,12 +62,19 @@ def _autopilot_args(p: argparse.ArgumentParser, recipe: bool) -> None:
     )
     p.add_argument(
         "--workers",
-        type=int,
+        type=_workers,
         default=1,
         help="worker processes flying episodes; the log and dataset are identical "
         "to one worker's (default: 1)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def _workers(text: str) -> int:
+    n = int(text)
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"{n} worker processes: give 1 or more")
+    return n
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -160,7 +167,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         required=True,
         help="session folder: logs/, dataset/ (the aggregate), policy-<k>/",
     )
-    dag.add_argument("--workers", type=int, default=1, help="worker processes (default: 1)")
+    dag.add_argument("--workers", type=_workers, default=1, help="worker processes (default: 1)")
     rep = sub.add_parser(
         "replay",
         help="re-fly logged episodes through JSBSim from their seeds "
@@ -246,20 +253,19 @@ def collect(cfg: object, progress: bool = True, workers: int = 1) -> int:
 
     assert isinstance(cfg, CollectConfig)
     # the pool starts before the bar's monitor thread, which would rule out a fork start
-    pool = Workers(min(workers, cfg.episodes))
-    bar = tqdm(
-        total=cfg.episodes, desc="episodes", unit="ep", disable=not progress, file=sys.stderr
-    )
+    with Workers(min(workers, cfg.episodes)) as pool:
+        bar = tqdm(
+            total=cfg.episodes, desc="episodes", unit="ep", disable=not progress, file=sys.stderr
+        )
 
-    def tick(i: int, ret: float) -> None:
-        bar.update(1)
-        bar.set_postfix(ret=f"{ret:.1f}")
-        if not progress:  # a line per durable episode, for logs and supervising scripts
-            print(f"episode {i} saved (return {ret:.1f})", flush=True)
+        def tick(i: int, ret: float) -> None:
+            bar.update(1)
+            bar.set_postfix(ret=f"{ret:.1f}")
+            if not progress:  # a line per durable episode, for logs and supervising scripts
+                print(f"episode {i} saved (return {ret:.1f})", flush=True)
 
-    with pool:
         result = record_autopilot(cfg, workers=pool, progress=tick)
-    bar.close()
+        bar.close()
     print(f"logged {len(result.episodes)} episodes ({result.steps} steps) to {result.log}")
     report = build_from_logs(sorted((cfg.out / LOGS).glob("*.mcap")), cfg.out / DATASET)
     report_build(report, cfg.out / DATASET)

@@ -118,15 +118,14 @@ def main(argv: list[str] | None = None) -> int:
     task_name = spec.task + ("-dynamic" if spec.dynamic else "")
     rows, flown = [], {}
     # one pool for every agent, started before the progress bar starts its thread
-    workers = Workers(min(args.workers, len(seeds)))
-    bar = tqdm(
-        total=len(agents) * len(seeds),
-        desc="episodes",
-        unit="ep",
-        disable=args.no_progress,
-        file=sys.stderr,
-    )
-    with workers:
+    with Workers(min(args.workers, len(seeds))) as workers:
+        bar = tqdm(
+            total=len(agents) * len(seeds),
+            desc="episodes",
+            unit="ep",
+            disable=args.no_progress,
+            file=sys.stderr,
+        )
         for name, agent in agents.items():
             bar.set_postfix_str(name)
             flown[name] = fly_many(spec, agent, seeds, workers, progress=lambda: bar.update(1))

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from gymfg_il.envs.single import AircraftEnv
-from gymfg_il.errors import ConfigError
+from gymfg_il.errors import ConfigError, EnvStateError
 
 T = TypeVar("T")
 
@@ -64,10 +64,18 @@ class AgentSpec:
 
     def key(self) -> str:
         """What a worker's cache knows this agent by: its spec, and for a checkpoint the
-        time its files last changed (one retrained in place is loaded afresh)."""
-        if self.path is None or not self.path.is_dir():
+        time and size of its config and weights (one retrained in place is loaded afresh)."""
+        if self.path is None:
             return repr(self)
-        stamps = sorted((f.name, f.stat().st_mtime_ns) for f in self.path.iterdir())
+        from gymfg_il.policies.factory import CONFIG_FILE, WEIGHTS_FILE
+
+        stamps: list[tuple[int, int] | None] = []
+        for name in (CONFIG_FILE, WEIGHTS_FILE):
+            try:
+                st = (self.path / name).stat()
+                stamps.append((st.st_mtime_ns, st.st_size))
+            except OSError:
+                stamps.append(None)  # loading it will say what is missing
         return repr((self, stamps))
 
     def meta(self) -> dict[str, Any]:
@@ -127,30 +135,36 @@ class Workers:
     """Worker processes kept for several ``map_seeds`` calls; ``close()`` (or the end of a
     ``with`` block) stops them.
 
-    A new worker costs more than its start: its first episode builds the env and agent and
-    touches memory it shares with its parent, each page then copied for it. On the 2-core
-    benchmark VM a fresh 2-worker pool added ~120 ms to 16 episodes of ~110 ms each, so
-    work that comes in several calls (eval's agents, benchmark rounds) shares one pool.
-    The pool starts here, before the caller starts threads (a progress bar's monitor) that
-    would rule out the fast ``fork`` start.
+    A new worker costs more than its start: it touches memory it shares with its parent,
+    each page then copied for it, and a start by ``forkserver`` (the safe choice once this
+    process runs threads) re-imports everything. Work that comes in several calls (eval's
+    agents, DAgger's rounds) therefore shares one pool, started here, before the caller
+    starts threads (a progress bar's monitor, training). ``Workers(1)`` starts no process:
+    its work runs in this one.
     """
 
     def __init__(self, n: int) -> None:
-        if not (isinstance(n, int) and n >= 1):
+        if not (isinstance(n, int) and not isinstance(n, bool) and n >= 1):
             raise ConfigError(f"workers={n!r}: give 1 or more worker processes")
         self.n = n
+        self.closed = False
         ctx = mp.get_context(_start_method())
         self._pool: Any = ctx.Pool(n, initializer=_worker_init) if n > 1 else None
 
-    def imap[T](self, fn: Callable[..., T], args: tuple[Any, ...], seeds: list[int]) -> Iterator[T]:
-        if self._pool is None:
-            raise ConfigError("these Workers are closed (or were made with n=1)")
+    def _imap[T](
+        self, fn: Callable[..., T], args: tuple[Any, ...], seeds: list[int]
+    ) -> Iterator[T]:
         jobs = [(fn, (*args, seed)) for seed in seeds]
         # one episode per task: a task costs ~0.1 ms to send, an episode ~100 ms to fly, and
         # the last worker to finish then waits at most one episode
-        return self._pool.imap(_call, jobs, chunksize=1)
+        results = self._pool.imap(_call, jobs, chunksize=1)
+        for _ in jobs:
+            if self.closed:  # a terminated pool's iterator would wait forever
+                raise EnvStateError("these Workers were closed while their results were read")
+            yield next(results)
 
     def close(self) -> None:
+        self.closed = True
         if self._pool is not None:
             self._pool.terminate()
             self._pool.join()
@@ -174,13 +188,20 @@ def map_seeds[T](
 
     ``fn`` must be a module-level function (it is pickled by name)."""
     seeds = list(seeds)
-    n = workers.n if isinstance(workers, Workers) else workers
-    if n <= 1 or len(seeds) <= 1:
+    if isinstance(workers, Workers):
+        if workers.closed:
+            raise EnvStateError("these Workers are closed; start new ones")
+        n = workers.n
+    elif isinstance(workers, int) and not isinstance(workers, bool) and workers >= 1:
+        n = workers
+    else:
+        raise ConfigError(f"workers={workers!r}: give 1 or more worker processes")
+    if n == 1 or len(seeds) <= 1:
         for seed in seeds:
             yield fn(*args, seed)
         return
     if isinstance(workers, Workers):
-        yield from workers.imap(fn, args, seeds)
+        yield from workers._imap(fn, args, seeds)
         return
     with Workers(min(n, len(seeds))) as pool:
-        yield from pool.imap(fn, args, seeds)
+        yield from pool._imap(fn, args, seeds)

@@ -1,3 +1,4 @@
+import operator
 import os
 import threading
 
@@ -5,9 +6,9 @@ import pytest
 
 from gymfg_il.collectors.autopilot import record_autopilot
 from gymfg_il.collectors.config import CollectConfig
-from gymfg_il.errors import ConfigError
+from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.evaluation.parallel import fly_many
-from gymfg_il.parallel import AgentSpec, EnvSpec, Workers
+from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, map_seeds
 from gymfg_il.recording.reader import read_log
 
 
@@ -29,24 +30,41 @@ def test_two_workers_give_what_one_gives(tmp_path):
         assert (sa.state == sb.state).all() and (sa.action == sb.action).all()
 
 
-def test_kept_workers_serve_several_calls_alike_and_see_a_retrained_checkpoint(tmp_path):
+def test_kept_workers_serve_several_calls_alike_and_refuse_use_after_close(tmp_path):
     spec = EnvSpec("roll", "c172p", episode_time_s=5)
     one = fly_many(spec, AgentSpec.controller(), [1, 2, 3], workers=1)
+    # fork while this process runs no other thread (an earlier test's tqdm monitor may)
+    expected = "fork" if threading.active_count() == 1 else "forkserver"
     with Workers(2) as workers:
-        assert threading.active_count() > 1  # the pool's own threads: it is running
+        assert workers._pool._ctx.get_start_method() == expected
         first = fly_many(spec, AgentSpec.controller(), [1, 2, 3], workers=workers)
+        other = fly_many(
+            EnvSpec("pitch", episode_time_s=5), AgentSpec.controller(), [1, 2], workers
+        )
         again = fly_many(spec, AgentSpec.controller(), [3, 2, 1], workers=workers)
+        pending = map_seeds(operator.add, (10,), [1, 2, 3], workers)
+        assert next(pending) == 11
+    assert [e.seed for e in other] == [1, 2]
     for a, b, c in zip(one, first, again[::-1], strict=True):
         assert (a.actions == b.actions).all() and (a.actions == c.actions).all()
-    with pytest.raises(ConfigError, match="closed"):
-        list(workers.imap(len, (), [1, 2]))
-    with pytest.raises(ConfigError, match="workers=0"):
-        Workers(0)
+    with pytest.raises(EnvStateError, match="closed while"):
+        next(pending)  # a closed pool's results would never come: an error, not a hang
+    with pytest.raises(EnvStateError, match="closed"):
+        list(map_seeds(operator.add, (10,), [1], workers))
+    for bad in (0, -1, True):
+        with pytest.raises(ConfigError, match=f"workers={bad!r}"):
+            Workers(bad)
+        with pytest.raises(ConfigError, match=f"workers={bad!r}"):
+            list(map_seeds(operator.add, (10,), [1], bad))
 
-    # a worker's cache knows a checkpoint by its files: rewritten in place, it is reloaded
+
+def test_a_checkpoint_rewritten_in_place_gets_a_new_cache_key(tmp_path):
     ckpt = tmp_path / "policy"
     ckpt.mkdir()
     (ckpt / "model.safetensors").write_bytes(b"v1")
+    (ckpt / "config.json").write_text("{}")
     before = AgentSpec.policy(ckpt).key()
+    (ckpt / "loss.png").write_bytes(b"unrelated")
+    assert AgentSpec.policy(ckpt).key() == before  # other files do not matter
     os.utime(ckpt / "model.safetensors", ns=(1, 1))
     assert AgentSpec.policy(ckpt).key() != before

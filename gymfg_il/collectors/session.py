@@ -54,7 +54,8 @@ def fly_and_label(
     """Fly one episode: ``actor`` chooses (plus Gaussian noise on the surfaces), ``expert``
     labels each visited state (the actor's own clean action when there is no expert)."""
     key = repr((env_spec, actor.key(), expert.key() if expert else None))
-    if key not in _cache:
+    if key not in _cache:  # one env and pair of agents at a time (DAgger's rounds differ)
+        _close_cached()
         env = env_spec.make()
         _cache[key] = (env, actor.make(env), expert.make(env) if expert else None)
     env, pilot, teacher = _cache[key]
@@ -231,7 +232,11 @@ def record_session(
                 if progress is not None:
                     progress(i, ep.total_return)
     finally:
-        for env, _, _ in _cache.values():
-            env.close()
-        _cache.clear()
+        _close_cached()
     return SessionResult(path, episodes)
+
+
+def _close_cached() -> None:
+    for env, _, _ in _cache.values():
+        env.close()
+    _cache.clear()

@@ -12,9 +12,11 @@ _cache: dict[str, tuple[Any, Any]] = {}
 
 
 def _fly(env_spec: EnvSpec, agent_spec: AgentSpec, seed: int) -> Episode:
-    # Workers keep their env and agent between seeds (each episode is reset by its seed).
+    # Workers keep their env and agent between seeds (each episode is reset by its seed),
+    # one pair at a time: a kept pool that moves on to another agent closes the last one.
     key = repr((env_spec, agent_spec.key()))
     if key not in _cache:
+        _close_cached()
         env = env_spec.make()
         _cache[key] = (env, agent_spec.make(env))
     env, agent = _cache[key]
@@ -36,10 +38,14 @@ def fly_many(
             if progress:
                 progress()
     finally:
-        for env, _ in _cache.values():
-            env.close()
-        _cache.clear()
+        _close_cached()
     return out
+
+
+def _close_cached() -> None:
+    for env, _ in _cache.values():
+        env.close()
+    _cache.clear()
 
 
 __all__ = ["AgentSpec", "EnvSpec", "Workers", "fly_many"]

@@ -32,8 +32,8 @@ class OnlineEnv:
         address: the server (``tcp://host:port``).
         token: the team's secret (per-team or shared), if the server asks for one.
         server_key: the server's CURVE public key, when it encrypts.
-        timeout_s: how long to wait for the server before giving up (a ``wait`` message from
-            a paused server restarts the clock).
+        timeout_s: how long to wait for the server before giving up (after ``spin_us`` of
+            polling; a ``wait`` message from a paused server restarts the clock).
         sim_hz, agent_hz: rates, as in ``OfflineEnv``.
         views, traffic: FlightGear views of the team's aircraft, as in ``OfflineEnv``; the
             opponents appear in them as multiplayer traffic (from what the server lets the
@@ -44,9 +44,10 @@ class OnlineEnv:
             interleaved runs rose 5-15%, less than that VM's run-to-run swing.
         spin_us: how long to poll for the server's reply, yielding the CPU between polls,
             before sleeping on it (0: sleep at once). Waking a sleeping thread is slow on a
-            virtual machine; polling for up to 1 ms per step raised two-team lockstep on
-            the 2-core benchmark VM by 10-20% (alternating blocks of one run), and costs at
-            most 1 ms of CPU per step when the other teams are slow.
+            virtual machine, and the lockstep pays for it at every step: on the 2-core
+            benchmark VM, polling made two-team lockstep clearly faster (benchmarks/run.py
+            prints both). It costs at most ``spin_us`` of CPU per step, and stops while
+            replies take longer than that (many teams sharing few CPUs).
 
     ``reset`` and ``step`` return what ``OfflineEnv`` returns; ``truncated`` also becomes True
     when the server ends the simulation (in a k-fixed simulation, when any team completes),
@@ -69,11 +70,19 @@ class OnlineEnv:
     ) -> None:
         import zmq
 
-        if not (isinstance(spin_us, int | float) and 0 <= spin_us <= 1e6):
-            raise ConfigError(f"spin_us={spin_us!r}: give 0 (no polling) to 1e6 microseconds")
+        if not (
+            isinstance(spin_us, int | float)
+            and not isinstance(spin_us, bool)
+            and 0 <= spin_us * 1e-6 < timeout_s
+        ):
+            raise ConfigError(
+                f"spin_us={spin_us!r}: give 0 (no polling) or a time in microseconds "
+                f"below timeout_s={timeout_s:g} s"
+            )
         self.address, self.token, self.timeout_s = address, token, timeout_s
         self._spin_s = spin_us * 1e-6
         self._wait_s = 0.0  # moving average of the wait for a reply
+        self._clock = time.perf_counter
         self.config = EnvConfig(sim_hz, agent_hz, views=views, traffic=traffic)
         self._affinity: set[int] | None = None  # the calling thread's, while pinned
         if cpu is not None:
@@ -126,7 +135,7 @@ class OnlineEnv:
         that fast, else slept on at once (RCVTIMEO bounds the sleep)."""
         import zmq
 
-        clock = time.perf_counter
+        clock = self._clock
         start = clock()
         if self._wait_s < self._spin_s:  # (typical waits: many teams sharing CPUs poll less)
             recv, pause = self.sock.recv, os.sched_yield
@@ -142,7 +151,10 @@ class OnlineEnv:
                     pause()  # the I/O thread bringing the reply may need this CPU
         else:
             data = self.sock.recv()
-        self._wait_s += 0.1 * (clock() - start - self._wait_s)
+        # a moving average of the waits, each counted as at most twice the polling time, so
+        # one long wait (a join, a reset, a paused server) does not turn polling off
+        waited = min(clock() - start, 2 * self._spin_s)
+        self._wait_s += 0.1 * (waited - self._wait_s)
         return data
 
     def _receive(self, expect: str) -> dict[str, Any]:

@@ -282,10 +282,64 @@ def test_a_pinned_client_runs_on_its_cpu_and_refuses_one_it_may_not_use():
         OnlineEnv("tcp://127.0.0.1:1", cpu=4096)
 
 
-@pytest.mark.parametrize("spin_us", [-1.0, float("nan"), float("inf"), "fast"])
+@pytest.mark.parametrize("spin_us", [-1.0, float("nan"), float("inf"), "fast", True, 2e6])
 def test_a_bad_polling_time_is_refused_by_name(spin_us):
     with pytest.raises(ConfigError, match=f"spin_us={spin_us!r}"):
-        OnlineEnv("tcp://127.0.0.1:1", spin_us=spin_us)
+        OnlineEnv("tcp://127.0.0.1:1", spin_us=spin_us, timeout_s=1.0)
+
+
+class SlowServer:
+    """A socket whose replies arrive ``delay`` seconds (of a fake clock) after a wait
+    begins; counts the polls (non-blocking tries) and the blocking receives."""
+
+    def __init__(self):
+        self.now, self.delay, self.ready_at = 0.0, 0.0, None
+        self.polls = self.sleeps = 0
+
+    def clock(self):
+        self.now += 20e-6  # every look at the clock costs 20 us
+        return self.now
+
+    def recv(self, flags=0):
+        if self.ready_at is None:
+            self.ready_at = self.now + self.delay
+        if flags & zmq.NOBLOCK:
+            self.polls += 1
+            if self.now < self.ready_at:
+                raise zmq.Again()
+        else:
+            self.sleeps += 1
+            self.now = max(self.now, self.ready_at)
+        self.ready_at = None
+        return b"reply"
+
+    def close(self, linger=0):
+        pass
+
+
+def test_a_client_polls_while_replies_are_quick_and_sleeps_while_they_are_slow():
+    env = OnlineEnv("tcp://127.0.0.1:1", spin_us=1000)
+    fake = SlowServer()
+    env.sock.close(0)
+    env.sock, env._clock = fake, fake.clock
+
+    def waits(delay, n):
+        fake.delay, fake.polls, fake.sleeps = delay, 0, 0
+        for _ in range(n):
+            assert env._recv() == b"reply"
+        return fake.polls, fake.sleeps
+
+    polls, sleeps = waits(300e-6, 20)  # quick replies: caught by polling, never slept on
+    assert polls > 20 and sleeps == 0
+    waits(5.0, 1)  # one long wait (a join, a reset) ...
+    polls, sleeps = waits(300e-6, 5)  # ... does not turn polling off
+    assert sleeps == 0
+    waits(3e-3, 30)  # replies slower than spin_us, step after step: polling stops
+    polls, sleeps = waits(3e-3, 5)
+    assert polls == 0 and sleeps == 5
+    polls, sleeps = waits(100e-6, 40)  # quick again: polling comes back
+    assert fake.polls > 0 and waits(100e-6, 5)[1] == 0
+    env.close()
 
 
 def test_a_teams_views_show_its_opponents_as_traffic(server, tmp_path):
