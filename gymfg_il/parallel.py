@@ -99,6 +99,34 @@ class AgentSpec:
         return agent
 
 
+# What this process flies with, kept between episodes (in a worker, between calls too):
+# key -> (env, agents...), one set at a time.
+_kept: dict[str, tuple[Any, ...]] = {}
+
+
+def kept[K: tuple[Any, ...]](key: str, build: Callable[[], K]) -> K:
+    """The env and agents known by ``key``, built on first use. One set is kept at a time:
+    a kept pool that moves on to another agent (eval's next one, DAgger's next round)
+    closes the last set instead of piling them up."""
+    if key not in _kept:
+        release_kept()
+        _kept[key] = build()
+    return _kept[key]  # type: ignore[return-value]  # stored by the build for this key
+
+
+def release_kept() -> None:
+    """Close the kept env (the end of a call in this process)."""
+    for env, *_ in _kept.values():
+        env.close()
+    _kept.clear()
+
+
+def _count(workers: object) -> int:
+    if not (isinstance(workers, int) and not isinstance(workers, bool) and workers >= 1):
+        raise ConfigError(f"workers={workers!r}: give 1 or more worker processes")
+    return workers
+
+
 def _worker_init() -> None:
     """One core per worker: two workers whose torch each spins two OpenMP threads on a
     2-core machine ran policy episodes 20x slower."""
@@ -144,9 +172,7 @@ class Workers:
     """
 
     def __init__(self, n: int) -> None:
-        if not (isinstance(n, int) and not isinstance(n, bool) and n >= 1):
-            raise ConfigError(f"workers={n!r}: give 1 or more worker processes")
-        self.n = n
+        self.n = _count(n)
         self.closed = False
         ctx = mp.get_context(_start_method())
         self._pool: Any = ctx.Pool(n, initializer=_worker_init) if n > 1 else None
@@ -192,10 +218,8 @@ def map_seeds[T](
         if workers.closed:
             raise EnvStateError("these Workers are closed; start new ones")
         n = workers.n
-    elif isinstance(workers, int) and not isinstance(workers, bool) and workers >= 1:
-        n = workers
     else:
-        raise ConfigError(f"workers={workers!r}: give 1 or more worker processes")
+        n = _count(workers)
     if n == 1 or len(seeds) <= 1:
         for seed in seeds:
             yield fn(*args, seed)

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, map_seeds
+from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, kept, map_seeds, release_kept
 from gymfg_il.recording.writer import TrajectoryWriter
 
 LOGS, DATASET = "logs", "dataset"
@@ -45,20 +45,18 @@ class FlownEpisode:
         return float(self.rewards.sum())
 
 
-_cache: dict[str, tuple[Any, Any, Any]] = {}
-
-
 def fly_and_label(
     env_spec: EnvSpec, actor: AgentSpec, expert: AgentSpec | None, noise: float, seed: int
 ) -> FlownEpisode:
     """Fly one episode: ``actor`` chooses (plus Gaussian noise on the surfaces), ``expert``
     labels each visited state (the actor's own clean action when there is no expert)."""
-    key = repr((env_spec, actor.key(), expert.key() if expert else None))
-    if key not in _cache:  # one env and pair of agents at a time (DAgger's rounds differ)
-        _close_cached()
+
+    def build() -> tuple[Any, Any, Any]:
         env = env_spec.make()
-        _cache[key] = (env, actor.make(env), expert.make(env) if expert else None)
-    env, pilot, teacher = _cache[key]
+        return env, actor.make(env), expert.make(env) if expert else None
+
+    key = repr((env_spec, actor.key(), expert.key() if expert else None))
+    env, pilot, teacher = kept(key, build)
     rng = np.random.default_rng([seed, 7919])
     obs, info = env.reset(seed=seed)
     pilot.reset(seed)
@@ -232,11 +230,5 @@ def record_session(
                 if progress is not None:
                     progress(i, ep.total_return)
     finally:
-        _close_cached()
+        release_kept()
     return SessionResult(path, episodes)
-
-
-def _close_cached() -> None:
-    for env, _, _ in _cache.values():
-        env.close()
-    _cache.clear()

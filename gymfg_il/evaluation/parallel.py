@@ -6,20 +6,16 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from gymfg_il.evaluation.rollout import Episode, fly_episode
-from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, map_seeds
-
-_cache: dict[str, tuple[Any, Any]] = {}
+from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, kept, map_seeds, release_kept
 
 
 def _fly(env_spec: EnvSpec, agent_spec: AgentSpec, seed: int) -> Episode:
-    # Workers keep their env and agent between seeds (each episode is reset by its seed),
-    # one pair at a time: a kept pool that moves on to another agent closes the last one.
-    key = repr((env_spec, agent_spec.key()))
-    if key not in _cache:
-        _close_cached()
+    # the env and agent are kept between seeds (each episode is reset by its seed)
+    def build() -> tuple[Any, Any]:
         env = env_spec.make()
-        _cache[key] = (env, agent_spec.make(env))
-    env, agent = _cache[key]
+        return env, agent_spec.make(env)
+
+    env, agent = kept(repr((env_spec, agent_spec.key())), build)
     return fly_episode(env, agent, seed)
 
 
@@ -38,14 +34,8 @@ def fly_many(
             if progress:
                 progress()
     finally:
-        _close_cached()
+        release_kept()
     return out
-
-
-def _close_cached() -> None:
-    for env, _ in _cache.values():
-        env.close()
-    _cache.clear()
 
 
 __all__ = ["AgentSpec", "EnvSpec", "Workers", "fly_many"]
