@@ -61,6 +61,13 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="encrypt with ZeroMQ CURVE; prints the public key clients need",
     )
     p.add_argument(
+        "--batch-io",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="run ZeroMQ's I/O thread under SCHED_BATCH (Linux), so a tick's replies go out "
+        "together instead of the thread preempting the server after each (default: on)",
+    )
+    p.add_argument(
         "--seconds", type=float, help="stop after this long (default: run until interrupted)"
     )
     return p.parse_args(argv)
@@ -88,6 +95,7 @@ def main(argv: list[str] | None = None) -> int:
             timeout_s=args.timeout,
             on_stall=args.on_stall,
             curve=args.curve,
+            batch_io=args.batch_io,
             **({"opponent_view": tuple(args.view)} if args.view else {}),
         )
         server = StateServer(config)

@@ -256,6 +256,24 @@ def fuzz_server():
     assert alive and len(states) == 10
 
 
+def io_thread_policies(pid):
+    """The scheduling policy of each ZeroMQ I/O thread of process ``pid``."""
+    tasks = Path(f"/proc/{pid}/task")
+    return [
+        os.sched_getscheduler(int(t.name))
+        for t in tasks.iterdir()
+        if (t / "comm").read_text().startswith("ZMQbg/IO")
+    ]
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="Linux only")
+def test_the_servers_io_thread_runs_batched_unless_told_not_to(server):
+    _, batched = server("--mode", "open")
+    _, default = server("--mode", "open", "--no-batch-io")
+    assert io_thread_policies(batched.pid) == [os.SCHED_BATCH]
+    assert io_thread_policies(default.pid) == [os.SCHED_OTHER]
+
+
 def test_a_pinned_client_runs_on_its_cpu_and_refuses_one_it_may_not_use():
     import threading
 
