@@ -310,7 +310,12 @@ def manual_loop(seconds: float) -> dict[str, float]:
 
 
 def online_client(
-    address: str, name: str, steps: int, cpu: int | None = None, spin_us: float = 1000.0
+    address: str,
+    name: str,
+    steps: int,
+    cpu: int | None = None,
+    spin_us: float = 1000.0,
+    batch_io: bool = True,
 ) -> None:
     """One team of one c172p flying ``steps`` lockstep steps; prints its steps/s."""
     from gymfg_il import Team
@@ -320,7 +325,7 @@ def online_client(
     from gymfg_il.tasks import LevelFlightTask
 
     team = Team(name, [(c172p(f"{name}-1"), LevelFlightTask)], episode_time_s=steps / 10 + 10)
-    env = OnlineEnv(address, timeout_s=60, cpu=cpu, spin_us=spin_us)
+    env = OnlineEnv(address, timeout_s=60, cpu=cpu, spin_us=spin_us, batch_io=batch_io)
     (obs,), _ = env.reset(team, seed=0)
     assert env.world is not None
     slot = env.world.slots[0]
@@ -379,7 +384,7 @@ def online(
     (``bare``: clients that only report, the messaging's own ceiling; ``pinned``: each
     client on a CPU of its own, ``OnlineEnv(cpu=i)``, as teams on separate machines;
     ``spin_us``: how long clients poll for a reply before sleeping on it; ``batch_io``:
-    the server's I/O thread under SCHED_BATCH)."""
+    the ZeroMQ I/O threads of server and clients under SCHED_BATCH)."""
     import os
 
     cpus = sorted(os.sched_getaffinity(0))
@@ -417,7 +422,15 @@ def online(
                     address,
                     f"team{i}",
                     str(steps),
-                    *([] if bare else [str(cpus[i % len(cpus)] if pinned else -1), str(spin_us)]),
+                    *(
+                        []
+                        if bare
+                        else [
+                            str(cpus[i % len(cpus)] if pinned else -1),
+                            str(spin_us),
+                            str(int(batch_io)),
+                        ]
+                    ),
                 ],
                 stdout=subprocess.PIPE,
             )
@@ -440,15 +453,25 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", type=Path, help="write the rows to this JSON file")
     p.add_argument("--quick", action="store_true", help="fewer, shorter rounds (a smoke run)")
     p.add_argument(
-        "--online-client", nargs=5, metavar="ADDRESS TEAM STEPS CPU SPIN_US", help=argparse.SUPPRESS
+        "--online-client",
+        nargs=6,
+        metavar="ADDRESS TEAM STEPS CPU SPIN_US BATCH_IO",
+        help=argparse.SUPPRESS,
     )
     p.add_argument(
         "--bare-client", nargs=3, metavar=("ADDRESS", "TEAM", "STEPS"), help=argparse.SUPPRESS
     )
     args = p.parse_args(argv)
     if args.online_client:
-        address, team, steps, cpu, spin = args.online_client
-        online_client(address, team, int(steps), int(cpu) if int(cpu) >= 0 else None, float(spin))
+        address, team, steps, cpu, spin, batch = args.online_client
+        online_client(
+            address,
+            team,
+            int(steps),
+            int(cpu) if int(cpu) >= 0 else None,
+            float(spin),
+            batch == "1",
+        )
         return 0
     if args.bare_client:
         bare_client(args.bare_client[0], args.bare_client[1], int(args.bare_client[2]))
@@ -519,9 +542,9 @@ def main(argv: list[str] | None = None) -> int:
     )
     sides = {
         "clients that sleep on every reply (spin_us=0)": {"spin_us": 0.0},
-        "server I/O thread at the default policy (--no-batch-io)": {"batch_io": False},
+        "ZeroMQ I/O threads at the default policy (batch_io off)": {"batch_io": False},
         "each client on its own CPU (OnlineEnv(cpu=i))": {"pinned": True},
-        "default (clients poll up to 1 ms; server I/O batched)": {},
+        "default (clients poll up to 1 ms; I/O threads batched)": {},
     }
     runs: dict[str, list[float]] = {side: [] for side in sides}
     for _ in range(1 if args.quick else 3):  # alternating rounds: a slow spell hits all sides
@@ -540,7 +563,7 @@ def main(argv: list[str] | None = None) -> int:
         2000,
         median=float(np.median(default)),
         sleeping_clients=max(sleeping),
-        server_io_default_policy=max(unbatched),
+        io_threads_default_policy=max(unbatched),
     )
     for teams in (8, 16):
         rate = online(teams, 300 if args.quick else 2000)

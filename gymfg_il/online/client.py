@@ -22,7 +22,10 @@ from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import EnvConfig, SimPool, World
 from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.online.protocol import ProtocolError, ServerError, decode, encode
+from gymfg_il.online.threads import first_socket
 from gymfg_il.sim.properties import ORIENTATION, POSITION
+
+_LEAVE_LINGER_MS = 250
 
 
 class OnlineEnv:
@@ -48,6 +51,9 @@ class OnlineEnv:
             benchmark VM, polling made two-team lockstep clearly faster (benchmarks/run.py
             prints both). It costs at most ``spin_us`` of CPU per step, and stops while
             replies take longer than that (many teams sharing few CPUs).
+        batch_io: run this client's ZeroMQ I/O thread under Linux's SCHED_BATCH policy and
+            yield the CPU right after each report, so the report leaves at once while the
+            thread never preempts the env elsewhere (see ``gymfg_il.online.threads``).
 
     ``reset`` and ``step`` return what ``OfflineEnv`` returns; ``truncated`` also becomes True
     when the server ends the simulation (in a k-fixed simulation, when any team completes),
@@ -67,6 +73,7 @@ class OnlineEnv:
         traffic: Mapping[str, Sequence[int]] | None = None,
         cpu: int | None = None,
         spin_us: float = 1000.0,
+        batch_io: bool = True,
     ) -> None:
         import zmq
 
@@ -91,11 +98,11 @@ class OnlineEnv:
                 raise ConfigError(f"cpu={cpu!r}: this process may run on CPUs {sorted(available)}")
             self._affinity = available
             os.sched_setaffinity(0, {cpu})  # this thread, and the I/O thread started below
-        # a pinned client starts its own context, so its I/O thread starts pinned too
-        self._own_ctx = cpu is not None
-        self.ctx: Any = zmq.Context() if self._own_ctx else zmq.Context.instance()
+        # the client's own context: its I/O thread starts pinned with it, and batched
+        self.ctx: Any = zmq.Context()
+        self._batch_io = batch_io
         try:
-            self.sock = self.ctx.socket(zmq.DEALER)
+            self.sock = first_socket(self.ctx, zmq.DEALER, batch_io)
             self.sock.setsockopt(zmq.LINGER, 0)
             self.sock.setsockopt(zmq.RCVTIMEO, int(timeout_s * 1000))
             if server_key is not None:
@@ -252,6 +259,8 @@ class OnlineEnv:
         world.step_physics(team_controls(team_actions, team.callsigns))
         terminated_now = all(s.terminated for s in world.slots)
         self._send({"type": "report", "states": self._states(), "done": world.truncated})
+        if self._batch_io:
+            os.sched_yield()  # the batched I/O thread, if it shares this CPU, sends it now
         # Rewards and observations need the other teams only when a reward targets them:
         # otherwise they are computed while the server gathers the other reports.
         early = not world.external
@@ -294,10 +303,9 @@ class OnlineEnv:
             self.joined = False
 
     def _release(self) -> None:
-        """End a pinned client's own context and give the thread its CPUs back."""
-        if self._own_ctx:
+        """End the client's context and give a pinned thread its CPUs back."""
+        if not self.ctx.closed:
             self.ctx.term()  # its socket is closed by now
-            self._own_ctx = False
         if self._affinity is not None:
             os.sched_setaffinity(0, self._affinity)
             self._affinity = None
@@ -306,7 +314,8 @@ class OnlineEnv:
         try:
             self.leave()
         finally:
-            self.sock.close(0)
+            # a leave still queued gets a moment to go out, so the others need not time out
+            self.sock.close(linger=_LEAVE_LINGER_MS)
             self._release()
             if self.world is not None:
                 self.world.close()

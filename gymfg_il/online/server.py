@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import hmac
 import logging
-import os
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.online.protocol import MAX_MESSAGE_BYTES, ProtocolError, decode, encode
+from gymfg_il.online.threads import first_socket
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
 
 log = logging.getLogger(__name__)
@@ -60,8 +59,7 @@ class ServerConfig:
         batch_io: run the server's ZeroMQ I/O thread under Linux's SCHED_BATCH policy, so
             that the replies of a tick are queued without the I/O thread preempting the
             server after the first one, and go out together when the server next waits
-            (on the 2-core benchmark VM: two-team lockstep 8-15% faster in alternating
-            blocks of one run; no change with 8 teams). False keeps the default policy.
+            (see ``gymfg_il.online.threads``). False keeps the default policy.
     """
 
     mode: str = "fixed"
@@ -91,23 +89,6 @@ class ServerConfig:
             raise ConfigError("server: " + "; ".join(problems))
 
 
-def _threads() -> set[Path]:
-    """This process's threads (Linux; empty elsewhere)."""
-    tasks = Path("/proc/self/task")
-    return set(tasks.iterdir()) if tasks.is_dir() else set()
-
-
-def _batch(threads: set[Path]) -> None:
-    """Put the ZeroMQ I/O threads among ``threads`` under SCHED_BATCH: woken by a send, they
-    no longer preempt the sender, and run when it next waits."""
-    for task in threads:
-        try:
-            if (task / "comm").read_text().startswith("ZMQbg/IO"):
-                os.sched_setscheduler(int(task.name), os.SCHED_BATCH, os.sched_param(0))
-        except OSError as err:  # gone, or not permitted (a SCHED_IDLE process): only slower
-            log.info("the ZeroMQ I/O thread keeps its scheduling policy: %s", err)
-
-
 class StateServer:
     """Serve until ``stop()`` (or for ``run(seconds)``)."""
 
@@ -116,10 +97,7 @@ class StateServer:
 
         self.config = config
         self.ctx = zmq.Context()
-        threads = _threads()
-        self.sock = self.ctx.socket(zmq.ROUTER)  # starts the context's I/O thread
-        if config.batch_io:
-            _batch(_threads() - threads)
+        self.sock = first_socket(self.ctx, zmq.ROUTER, config.batch_io)
         self.sock.setsockopt(zmq.LINGER, 0)
         self.sock.setsockopt(zmq.MAXMSGSIZE, 4 * MAX_MESSAGE_BYTES)
         self.auth: Any = None
@@ -266,7 +244,7 @@ class StateServer:
     def _leave(self, identity: bytes, msg: dict[str, Any]) -> None:
         team = self.teams.get(msg["team"])
         if team is not None and team.identity == identity:
-            team.active, team.report = False, None
+            team.active, team.report, team.states = False, None, {}  # others stop seeing it
             log.info("team %s left", team.name)
             self._maybe_broadcast()
 

@@ -257,21 +257,28 @@ def fuzz_server():
 
 
 def io_thread_policies(pid):
-    """The scheduling policy of each ZeroMQ I/O thread of process ``pid``."""
+    """Thread id -> scheduling policy of each ZeroMQ I/O thread of process ``pid``."""
     tasks = Path(f"/proc/{pid}/task")
-    return [
-        os.sched_getscheduler(int(t.name))
+    return {
+        t.name: os.sched_getscheduler(int(t.name))
         for t in tasks.iterdir()
         if (t / "comm").read_text().startswith("ZMQbg/IO")
-    ]
+    }
 
 
 @pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="Linux only")
-def test_the_servers_io_thread_runs_batched_unless_told_not_to(server):
+def test_io_threads_run_batched_unless_told_not_to(server):
     _, batched = server("--mode", "open")
     _, default = server("--mode", "open", "--no-batch-io")
-    assert io_thread_policies(batched.pid) == [os.SCHED_BATCH]
-    assert io_thread_policies(default.pid) == [os.SCHED_OTHER]
+    assert list(io_thread_policies(batched.pid).values()) == [os.SCHED_BATCH]
+    assert list(io_thread_policies(default.pid).values()) == [os.SCHED_OTHER]
+    for batch_io, policy in ((True, os.SCHED_BATCH), (False, os.SCHED_OTHER)):
+        before = io_thread_policies(os.getpid())
+        env = OnlineEnv("tcp://127.0.0.1:1", batch_io=batch_io)
+        new = {tid: p for tid, p in io_thread_policies(os.getpid()).items() if tid not in before}
+        env.close()
+        assert list(new.values()) == [policy]  # the client's own thread, no other
+        assert {tid: io_thread_policies(os.getpid()).get(tid) for tid in before} == before
 
 
 def test_a_pinned_client_runs_on_its_cpu_and_refuses_one_it_may_not_use():
@@ -440,3 +447,34 @@ def test_reward_targets_read_the_view_the_server_announces(server):
     thread.join(20)
     blue.close(0)
     assert seen == [98.0, 98.0]
+
+
+def test_a_team_that_leaves_holds_up_no_one(server):
+    """``close`` sends ``leave`` and lets it go out: the other team flies on at once, not
+    after the server's stall timeout (60 s here, beyond the client's 5 s), and stops seeing
+    the team that left."""
+    import threading
+
+    from gymfg_il import Team
+    from gymfg_il.aircraft import c172p
+    from gymfg_il.tasks import DummyTask
+
+    address, _ = server("--mode", "open", "--timeout", "60")
+    blue = OnlineEnv(address, timeout_s=5)
+    blue.reset(Team("blue", [(c172p("blue-1"), DummyTask)], episode_time_s=1e4), seed=1)
+
+    def fly_blue():  # alone until red joins, then 5 steps in lockstep with red, then leave
+        while "red-1" not in blue.step(np.zeros(4))[5]["opponent_callsigns"]:
+            pass
+        for _ in range(5):
+            blue.step(np.zeros(4))
+        blue.close()
+
+    thread = threading.Thread(target=fly_blue)
+    thread.start()
+    red = OnlineEnv(address, timeout_s=5)
+    red.reset(Team("red", [(c172p("red-1"), DummyTask)]), seed=0)
+    seen = [red.step(np.zeros(4))[5]["opponent_callsigns"] for _ in range(12)]
+    thread.join(10)
+    red.close()
+    assert seen[0] == ["blue-1"] and seen[-1] == []
