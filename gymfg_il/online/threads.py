@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import os
+import time
 from pathlib import Path
 from typing import Any
 
@@ -25,11 +26,17 @@ def _threads() -> set[Path]:
     return set(tasks.iterdir()) if tasks.is_dir() else set()
 
 
-def _batch(threads: set[Path]) -> None:
+def _name(task: Path) -> str:
+    try:
+        return (task / "comm").read_text()
+    except OSError:  # the thread ended meanwhile
+        return ""
+
+
+def _batch(threads: list[Path]) -> None:
     for task in threads:
         try:
-            if (task / "comm").read_text().startswith("ZMQbg/IO"):
-                os.sched_setscheduler(int(task.name), os.SCHED_BATCH, os.sched_param(0))
+            os.sched_setscheduler(int(task.name), os.SCHED_BATCH, os.sched_param(0))
         except OSError as err:  # gone, or not permitted (a SCHED_IDLE process): only slower
             log.info("a ZeroMQ I/O thread keeps its scheduling policy: %s", err)
 
@@ -39,6 +46,13 @@ def first_socket(ctx: Any, kind: int, batch: bool) -> Any:
     with that thread under SCHED_BATCH when ``batch``. Other threads are left alone."""
     before = _threads() if batch else set()
     sock = ctx.socket(kind)
-    if batch:
-        _batch(_threads() - before)
+    if batch and before:
+        # a new thread names itself once running: wait (briefly) to tell the I/O thread
+        deadline = time.monotonic() + 1.0
+        while True:
+            io = [t for t in _threads() - before if _name(t).startswith("ZMQbg/IO")]
+            if io or time.monotonic() > deadline:
+                break
+            time.sleep(0.0005)
+        _batch(io)
     return sock
