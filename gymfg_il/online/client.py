@@ -203,10 +203,12 @@ class OnlineEnv:
             others.clear()
             for callsign, _, values in rows:
                 others[callsign] = np.asarray(values, dtype=np.float64)[self._pose_at]
-        for callsign, _, values in rows:
-            view = self.world.external.get(callsign)
-            if view is not None:
-                view.values = np.asarray(values, dtype=np.float64)
+        external = self.world.external  # opponents a reward targets
+        if external:
+            for callsign, _, values in rows:
+                view = external.get(callsign)
+                if view is not None:
+                    view.values = np.asarray(values, dtype=np.float64)
         if not rows:
             return np.zeros((0, len(self.view)))
         return np.array([r[2] for r in rows], dtype=np.float64)
@@ -266,34 +268,38 @@ class OnlineEnv:
         early = not world.external
         try:
             if early:
-                world.score()
-                observations = [world.observation(s) for s in world.slots]
+                observations, rewards, terminated, info = self._outcome()
         finally:  # even when scoring fails, this tick's reply must not be left unread
             central = self._receive("central")
         opponents = self._opponents(central)
         if not early:
-            world.score()
-            observations = [world.observation(s) for s in world.slots]
-        slots = world.slots
-        terminated = all(s.terminated for s in slots) or terminated_now
+            observations, rewards, terminated, info = self._outcome()
+        terminated = terminated or terminated_now
         truncated = (world.truncated or bool(central["done"])) and not terminated
         self._done = terminated or truncated
+        info["tick"] = central["tick"]
+        info["opponent_callsigns"] = list(self.opponents)
+        info["server_reason"] = central.get("reason", "")
+        return observations, opponents, rewards, terminated, truncated, info
+
+    def _outcome(self) -> tuple[list[np.ndarray], np.ndarray, bool, dict[str, Any]]:
+        """What the step returns of the team's own aircraft: observations, rewards, whether
+        all are terminated, and the info the server's reply does not change."""
+        world = self.world
+        assert world is not None
+        world.score()
+        slots = world.slots
+        terminated = [s.terminated for s in slots]
         info = {
             "step": world.steps,
             "time_s": world.steps * world.dt,
-            "tick": central["tick"],
-            "terminated": [s.terminated for s in slots],
+            "terminated": terminated,
             "reasons": {s.callsign: s.reason for s in slots if s.reason},
-            "opponent_callsigns": list(self.opponents),
-            "server_reason": central.get("reason", ""),
         }
-        rewards = np.array([s.reward for s in slots])
         return (
-            observations,
-            opponents,
-            rewards,
-            terminated,
-            truncated,
+            [world.observation(s) for s in slots],
+            np.array([s.reward for s in slots]),
+            all(terminated),
             info,
         )
 

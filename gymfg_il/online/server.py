@@ -34,6 +34,7 @@ class TeamRecord:
     identity: bytes
     token: str
     callsigns: list[str]
+    members: frozenset[str] = frozenset()  # the callsigns, as a set
     active: bool = False  # takes part in the lockstep
     report: dict[str, list[float]] | None = None  # this tick's report
     done: bool = False
@@ -194,7 +195,7 @@ class StateServer:
                     "teams; callsigns are unique in a simulation",
                 )
                 return
-            self.teams[name] = TeamRecord(name, identity, token, callsigns)
+            self.teams[name] = TeamRecord(name, identity, token, callsigns, frozenset(callsigns))
             for c in callsigns:
                 self.owner[c] = name
         log.info("team %s joined (%d teams)", name, len(self.teams))
@@ -223,17 +224,17 @@ class StateServer:
             self._error(identity, "unauthorised", f"team {name!r}: wrong token")
             return
         states = msg["states"]
-        foreign = sorted(set(states) - set(team.callsigns))
-        if foreign:
-            self._error(
-                identity,
-                "forbidden",
-                f"team {name!r} may only report its own aircraft, not {foreign}",
-            )
-            return
-        missing = sorted(set(team.callsigns) - set(states))
-        if missing:
-            self._error(identity, "malformed", f"team {name!r} did not report {missing}")
+        if states.keys() != team.members:  # (one set comparison on the common path)
+            foreign = sorted(states.keys() - team.members)
+            if foreign:
+                self._error(
+                    identity,
+                    "forbidden",
+                    f"team {name!r} may only report its own aircraft, not {foreign}",
+                )
+            else:
+                missing = sorted(team.members - states.keys())
+                self._error(identity, "malformed", f"team {name!r} did not report {missing}")
             return
         team.report, team.done = states, bool(msg.get("done", False))
         team.states = states
