@@ -338,15 +338,17 @@ def online_client(
 
 
 def bare_client(address: str, name: str, steps: int) -> None:
-    """The messaging alone: one team reporting a fixed state every step, no simulation."""
+    """The messaging alone: one team reporting a fixed state every step, no simulation,
+    sending and waiting as OnlineEnv does (batched I/O thread, polling)."""
     import os
 
     import zmq
 
     from gymfg_il.online.protocol import decode, encode
+    from gymfg_il.online.threads import first_socket
     from gymfg_il.sim.properties import NAMES
 
-    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock = first_socket(zmq.Context(), zmq.DEALER, batch=True)
     sock.connect(address)
     sock.send(encode({"type": "join", "team": name, "token": "", "aircraft": {name: "c172p"}}))
     decode(sock.recv(), "server")
@@ -354,7 +356,7 @@ def bare_client(address: str, name: str, steps: int) -> None:
         {"type": "report", "team": name, "token": "", "states": {name: [0.5] * len(NAMES)}}
     )
 
-    def recv() -> bytes:  # as OnlineEnv waits: poll, yielding the CPU, for up to 1 ms
+    def recv() -> bytes:  # poll, yielding the CPU, for up to 1 ms
         deadline = time.perf_counter() + 1e-3
         while time.perf_counter() < deadline:
             try:
@@ -366,6 +368,7 @@ def bare_client(address: str, name: str, steps: int) -> None:
     t0 = time.perf_counter()
     for _ in range(steps):
         sock.send(report)
+        os.sched_yield()
         while decode(recv(), "server")["type"] != "central":
             pass
     print(f"RATE {steps / (time.perf_counter() - t0)}", flush=True)
