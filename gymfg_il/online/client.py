@@ -44,9 +44,10 @@ class OnlineEnv:
         cpu: run this client and ZeroMQ's I/O thread on this one CPU (the thread's CPUs
             come back at ``close``). Where several teams share a machine, give each its own
             CPU: unpinned, the scheduler at times stacks two busy clients on one CPU. On the
-            2-core benchmark VM two pinned teams ran 10-20% faster than unpinned ones in
-            alternating rounds (medians 2,202 vs 2,001 and 2,303 vs 1,880 steps/s). Pinning
-            is left to the caller: a pinned thread's child processes inherit its one CPU.
+            2-core benchmark VM two pinned teams ran 4-22% faster than unpinned ones in
+            alternating rounds (medians 2,154 vs 2,077, 2,202 vs 2,001, 2,303 vs 1,880
+            steps/s). Pinning is left to the caller: a pinned thread's child processes
+            inherit its one CPU.
         spin_us: how long to poll for the server's reply, yielding the CPU between polls,
             before sleeping on it (0: sleep at once). Waking a sleeping thread is slow on a
             virtual machine, and the lockstep pays for it at every step: on the 2-core
