@@ -34,12 +34,15 @@ class TeamRecord:
     identity: bytes
     token: str
     callsigns: list[str]
-    members: frozenset[str] = frozenset()  # the callsigns, as a set
+    members: frozenset[str] = field(init=False)  # the callsigns, as a set
     active: bool = False  # takes part in the lockstep
     report: dict[str, list[float]] | None = None  # this tick's report
     done: bool = False
     last_seen: float = field(default_factory=time.monotonic)
     states: dict[str, list[float]] = field(default_factory=dict)  # latest
+
+    def __post_init__(self) -> None:
+        self.members = frozenset(self.callsigns)
 
 
 @dataclass
@@ -195,7 +198,7 @@ class StateServer:
                     "teams; callsigns are unique in a simulation",
                 )
                 return
-            self.teams[name] = TeamRecord(name, identity, token, callsigns, frozenset(callsigns))
+            self.teams[name] = TeamRecord(name, identity, token, callsigns)
             for c in callsigns:
                 self.owner[c] = name
         log.info("team %s joined (%d teams)", name, len(self.teams))
