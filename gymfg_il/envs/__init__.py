@@ -1,17 +1,30 @@
-"""Environments: the offline env (paper loop), gymnasium and PettingZoo adapters, scenarios."""
+"""Environments: the offline env (paper loop), gymnasium and PettingZoo adapters, scenarios,
+and the flight spec that describes what any of them flies.
 
+Modules: ``team`` (Team), ``world`` (the lockstep of every aircraft), ``config`` (EnvConfig),
+``offline`` (OfflineEnv), ``single`` (AircraftEnv, gymnasium), ``multiagent`` (the PettingZoo
+ParallelEnv), ``flight`` (FlightSpec), ``roster`` (its aircraft and teams), ``scenarios``
+(joint starts), ``display`` (FlightGear views), ``actions`` (the action contract),
+``registration`` (gymnasium ids).
+"""
+
+from gymfg_il.envs.config import EnvConfig
+from gymfg_il.envs.flight import AircraftSpec, FlightSpec, TeamSpec
+from gymfg_il.envs.multiagent import GymFGParallelEnv, parallel_env
 from gymfg_il.envs.offline import OfflineEnv
-from gymfg_il.envs.parallel import GymFGParallelEnv, parallel_env
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.envs.team import Team
-from gymfg_il.envs.world import EnvConfig, World
+from gymfg_il.envs.world import World
 
 __all__ = [
     "AircraftEnv",
+    "AircraftSpec",
     "EnvConfig",
+    "FlightSpec",
     "GymFGParallelEnv",
     "OfflineEnv",
     "Team",
+    "TeamSpec",
     "World",
     "parallel_env",
 ]

@@ -52,6 +52,12 @@ def controls(action: object, who: str = "action") -> Controls:
     return _clip(a0, a1, a2, a3)
 
 
+def clip(action: object, who: str = "action") -> np.ndarray:
+    """One aircraft's action clipped to the contract (float64, shape (4,)): the one clipping
+    every pilot's output goes through; NaN, inf or a wrong shape raise ActionError."""
+    return np.array(controls(action, who))
+
+
 def team_controls(action: object, callsigns: Sequence[str]) -> list[Controls]:
     """A team's stacked action (``np.hstack`` of one 4-vector per aircraft) split and checked."""
     n = len(callsigns)

@@ -20,11 +20,14 @@ import numpy as np
 
 from gymfg_il.controllers.agent import Agent
 from gymfg_il.envs.actions import Controls, controls, team_controls
+from gymfg_il.envs.config import EnvConfig
+from gymfg_il.envs.scenarios import Scenario
 from gymfg_il.envs.team import Team
-from gymfg_il.envs.world import EnvConfig, Scenario, SimPool, World
+from gymfg_il.envs.world import SimPool, World
 from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 
 TeamState = list[np.ndarray]
 
@@ -55,8 +58,8 @@ class OfflineEnv:
         self,
         opponents: Sequence[tuple[Team, Sequence[Agent]]] = (),
         *,
-        sim_hz: int = 120,
-        agent_hz: int = 10,
+        sim_hz: int = DEFAULT_SIM_HZ,
+        agent_hz: int = DEFAULT_AGENT_HZ,
         opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW,
         scenario: Scenario | None = None,
         views: Mapping[str, Sequence[int]] | None = None,

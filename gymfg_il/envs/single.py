@@ -11,13 +11,15 @@ import numpy as np
 
 from gymfg_il.aircraft import Aircraft
 from gymfg_il.envs.actions import controls
+from gymfg_il.envs.config import EnvConfig
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.envs.team import Team
-from gymfg_il.envs.world import EnvConfig, World
+from gymfg_il.envs.world import World
 from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 from gymfg_il.tasks.base import Task
-from gymfg_il.tasks.library import task_class
 from gymfg_il.tasks.targets import TargetTask
 
 
@@ -47,6 +49,9 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
 
     ``reset(options=...)`` takes ``initial_conditions`` (an ``InitialConditions``) and
     ``target`` (a fixed target for that episode, in the task's convention).
+
+    ``env.flight`` is the ``FlightSpec`` of what this env flies; ``AircraftEnv.from_flight``
+    builds the env a spec describes.
     """
 
     metadata = {"render_modes": []}  # noqa: RUF012
@@ -58,8 +63,8 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         *,
         dynamic: bool = False,
         task_kwargs: Mapping[str, Any] | None = None,
-        agent_hz: int = 10,
-        sim_hz: int = 120,
+        agent_hz: int = DEFAULT_AGENT_HZ,
+        sim_hz: int = DEFAULT_SIM_HZ,
         episode_time_s: float = 90.0,
         render_mode: str | None = None,
         views: Sequence[int] | None = None,
@@ -67,24 +72,36 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         if render_mode is not None:
             raise ConfigError(f"render_mode={render_mode!r} is not supported; use None")
         kwargs = dict(task_kwargs or {})
+        flight: FlightSpec | None = None
         if isinstance(task, str):
-            spec: Any = functools.partial(task_class(task, dynamic), **kwargs)
-        elif isinstance(task, type) and issubclass(task, Task):
-            spec = functools.partial(task, **kwargs)
-        elif isinstance(task, Task):
-            if kwargs:
-                raise ConfigError("task_kwargs apply to a task name or class, not an instance")
-            spec = task
+            flight = FlightSpec.solo(
+                aircraft,
+                task,
+                dynamic=dynamic,
+                task_kwargs=kwargs,
+                agent_hz=agent_hz,
+                sim_hz=sim_hz,
+                episode_time_s=episode_time_s,
+            )
+            team = flight.build_teams()[0]
         else:
-            raise ConfigError(f"task={task!r} must be a family name, a Task class or instance")
-        self.aircraft = Aircraft(aircraft, "ego")
-        team = Team("ego", [(self.aircraft, spec)], episode_time_s=episode_time_s)
+            if isinstance(task, type) and issubclass(task, Task):
+                spec: Any = functools.partial(task, **kwargs)
+            elif isinstance(task, Task):
+                if kwargs:
+                    raise ConfigError("task_kwargs apply to a task name or class, not an instance")
+                spec = task
+            else:
+                raise ConfigError(f"task={task!r} must be a family name, a Task class or instance")
+            team = Team("ego", [(Aircraft(aircraft, "ego"), spec)], episode_time_s=episode_time_s)
+        self.aircraft = team.aircraft[0]
         self.world = World(
             [team],
             EnvConfig(
                 sim_hz=sim_hz, agent_hz=agent_hz, views={"ego": list(views)} if views else None
             ),
         )
+        self.flight = flight or FlightSpec.of_world(self.world)
         self._slot = self.world.slots[0]
         self.task = self._slot.task
         low, high = self.task.observation_bounds()
@@ -93,6 +110,21 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         self.observation_names = self.task.observation_names
         self.render_mode = render_mode
         self._done = True
+
+    @classmethod
+    def from_flight(cls, flight: FlightSpec, views: Sequence[int] | None = None) -> AircraftEnv:
+        """The env of a solo flight spec."""
+        ego = flight.solo_aircraft
+        return cls(
+            ego.task,
+            ego.model,
+            dynamic=ego.dynamic,
+            task_kwargs=ego.task_kwargs,
+            agent_hz=flight.agent_hz,
+            sim_hz=flight.sim_hz,
+            episode_time_s=flight.episode_time_s,
+            views=views,
+        )
 
     @property
     def dt(self) -> float:

@@ -8,89 +8,27 @@ clock; it knows nothing about who chooses the actions.
 from __future__ import annotations
 
 import math
-import time
 import zlib
 from collections import deque
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from gymfg_il.aircraft import Aircraft
 from gymfg_il.envs.actions import Controls
+from gymfg_il.envs.config import EnvConfig
+from gymfg_il.envs.display import Displays
 from gymfg_il.envs.team import Team, build_task, check_unique
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
-from gymfg_il.sim.properties import (
-    DEFAULT_OPPONENT_VIEW,
-    NAMES,
-    ORIENTATION,
-    POSITION,
-    StateView,
-    indices,
-)
+from gymfg_il.sim.properties import NAMES, StateView, indices
 from gymfg_il.sim.simulation import Simulation
-from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, episode_steps, substeps
+from gymfg_il.sim.timing import episode_steps
 from gymfg_il.tasks.base import Task
 from gymfg_il.tasks.rewards import RewardContext
 
-# A scenario sets joint initial conditions: (rng, [(team name, aircraft), ...]) -> {callsign: ic}.
-Scenario = Callable[
-    [np.random.Generator, Sequence[tuple[str, Aircraft]]], Mapping[str, InitialConditions]
-]
-
-
-@dataclass(frozen=True)
-class EnvConfig:
-    """Settings shared by every environment.
-
-    Args:
-        sim_hz: JSBSim rate (Hz).
-        agent_hz: agent rate (Hz); must divide ``sim_hz`` exactly; it is a dataset's fps.
-        opponent_view: the state variables an aircraft sees of other teams' aircraft
-            (position and orientation by default, as in the paper).
-        scenario: joint initial conditions overriding the tasks' own (see ``envs.scenarios``).
-        views: callsign -> UDP ports of FlightGear views of that aircraft. Only aircraft
-            listed here open a socket (the paper warns that a view per aircraft can load a
-            network); while any view is attached the simulation paces itself to real time.
-        traffic: callsign -> multiplayer UDP ports of the views of that aircraft
-            (``FlightGear(multiplayer_port=...)``): every other aircraft of the simulation,
-            opponents of an online client included, is sent there and appears in the view.
-    """
-
-    sim_hz: int = DEFAULT_SIM_HZ
-    agent_hz: int = DEFAULT_AGENT_HZ
-    opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW
-    scenario: Scenario | None = None
-    views: Mapping[str, Sequence[int]] | None = None
-    traffic: Mapping[str, Sequence[int]] | None = None
-
-    def __post_init__(self) -> None:
-        substeps(self.sim_hz, self.agent_hz)
-        from gymfg_il.viz.multiplayer import port_problem
-
-        problems = [
-            f"traffic of {c!r}: {problem}"
-            for c, ports in (self.traffic or {}).items()
-            for problem in map(port_problem, ports)
-            if problem
-        ]
-        if problems:
-            raise ConfigError("; ".join(problems))
-        view = tuple(self.opponent_view)
-        object.__setattr__(self, "opponent_view", view)
-        indices(view)
-        if len(set(view)) != len(view):
-            raise ConfigError(f"opponent_view lists a variable twice: {view}")
-        if self.scenario is not None and not callable(self.scenario):
-            raise ConfigError(
-                f"scenario must be callable (rng, aircraft) -> ics, got {self.scenario!r}"
-            )
-
-    @property
-    def dt(self) -> float:
-        return 1.0 / self.agent_hz
+__all__ = ["EnvConfig", "SimPool", "Slot", "World"]
 
 
 class SimPool:
@@ -198,29 +136,21 @@ class World:
         self.by_callsign = {s.callsign: s for s in self.slots}
         self.team_slots = {t.name: [s for s in self.slots if s.team == t.name] for t in teams}
         self.external: dict[str, StateView] = {}
-        self._external_targets = external_targets
+        self.external_targets = external_targets
         self._link_reward_targets()
-        self.senders: dict[str, Any] = {}
-        for callsign, ports in (config.views or {}).items():
-            if callsign not in self.by_callsign:
-                raise ConfigError(f"views name {callsign!r}, which is not in this simulation")
-            from gymfg_il.viz.netfdm import FlightGearSender
-
-            self.senders[callsign] = FlightGearSender(list(ports))
-        self.traffic: dict[str, Any] = {}
-        for callsign, ports in (config.traffic or {}).items():
-            if callsign not in self.by_callsign:
-                raise ConfigError(f"traffic names {callsign!r}, which is not in this simulation")
-            from gymfg_il.viz.multiplayer import TrafficSender
-
-            self.traffic[callsign] = TrafficSender(list(ports))
-        self._pose_idx = indices(POSITION + ORIENTATION)
-        # aircraft simulated elsewhere (an online client's opponents): callsign -> lat, lon,
-        # altitude, roll, pitch, heading, for the views' traffic
-        self.others: dict[str, np.ndarray] = {}
-        self._next_frame = 0.0
+        self.displays = Displays(self.by_callsign, config.views, config.traffic, self.dt)
         self.steps = 0
         self.started = False
+
+    @property
+    def traffic(self) -> dict[str, Any]:
+        """The multiplayer senders of the views (empty when no view shows traffic)."""
+        return self.displays.traffic
+
+    @property
+    def others(self) -> dict[str, np.ndarray]:
+        """Poses of aircraft simulated elsewhere, shown in the views as traffic."""
+        return self.displays.others
 
     def _link_reward_targets(self) -> None:
         view_names = self.config.opponent_view
@@ -229,7 +159,7 @@ class World:
                 slot = self.by_callsign[owner.callsign]
                 for target in targets:
                     source = self.by_callsign.get(target.callsign)
-                    if source is None and self._external_targets:
+                    if source is None and self.external_targets:
                         view = self.external.setdefault(
                             target.callsign, StateView(np.full(len(view_names), np.nan), view_names)
                         )
@@ -286,7 +216,8 @@ class World:
             slot.history.clear()
         self.steps = 0
         self.started = True
-        self._show()
+        if self.displays:
+            self.displays.show()
 
     def advance(self, actions: Sequence[Controls | None]) -> None:
         """Apply one action per slot (None for terminated aircraft), step, score, check ends."""
@@ -308,30 +239,8 @@ class World:
             slot.prev_action = slot.action
             slot.action = np.array(act)
         self.steps += 1
-        self._show()
-
-    def _show(self) -> None:
-        """Feed the FlightGear views, at real time (FlightGear drops packets that come faster)."""
-        if not (self.senders or self.traffic):
-            return
-        for callsign, sender in self.senders.items():
-            slot = self.by_callsign[callsign]
-            sender.send(slot.sim.fdm, slot.sim.engines)
-        if self.traffic:
-            self._send_traffic()
-        now = time.perf_counter()
-        if self._next_frame > now:
-            time.sleep(self._next_frame - now)
-        self._next_frame = max(now, self._next_frame) + self.dt
-
-    def _send_traffic(self) -> None:
-        poses = [(s.callsign, s.aircraft.model, s.state[self._pose_idx]) for s in self.slots]
-        # an online client's opponents; their model is unknown here: FlightGear's fallback
-        poses += [(callsign, "", pose) for callsign, pose in self.others.items()]
-        for viewer, sender in self.traffic.items():
-            for callsign, model, pose in poses:
-                if callsign != viewer and np.isfinite(pose).all():
-                    sender.send(callsign, model, pose)
+        if self.displays:
+            self.displays.show()
 
     def score(self) -> None:
         """Rewards and terminations of the step just taken."""
@@ -384,8 +293,6 @@ class World:
         return np.stack(rows)
 
     def close(self) -> None:
-        for sender in [*self.senders.values(), *self.traffic.values()]:
-            sender.close()
-        self.senders, self.traffic = {}, {}
+        self.displays.close()
         self.pool.give_back([s.sim for s in self.slots])
         self.slots = []

@@ -18,12 +18,14 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.envs.actions import team_controls
+from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.team import Team
-from gymfg_il.envs.world import EnvConfig, SimPool, World
+from gymfg_il.envs.world import SimPool, World
 from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.online.protocol import ProtocolError, ServerError, decode, encode
 from gymfg_il.online.threads import first_socket
 from gymfg_il.sim.properties import ORIENTATION, POSITION
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 
 _LEAVE_LINGER_MS = 250
 
@@ -70,8 +72,8 @@ class OnlineEnv:
         token: str = "",
         server_key: bytes | None = None,
         timeout_s: float = 10.0,
-        sim_hz: int = 120,
-        agent_hz: int = 10,
+        sim_hz: int = DEFAULT_SIM_HZ,
+        agent_hz: int = DEFAULT_AGENT_HZ,
         views: Mapping[str, Sequence[int]] | None = None,
         traffic: Mapping[str, Sequence[int]] | None = None,
         cpu: int | None = None,

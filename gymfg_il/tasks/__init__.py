@@ -21,6 +21,7 @@ from gymfg_il.tasks.library import (
     ReachStaticTargetPitchTask,
     ReachStaticTargetRollTask,
     task_class,
+    task_reference,
 )
 from gymfg_il.tasks.rewards import RewardContext, RewardFn
 from gymfg_il.tasks.targets import FAMILIES, TargetFamily, TargetTask
@@ -47,4 +48,5 @@ __all__ = [
     "TargetTask",
     "Task",
     "task_class",
+    "task_reference",
 ]

@@ -7,7 +7,7 @@ reward without a subclass is one lambda: ``DummyTask(reward=lambda ctx: ...)``.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -69,6 +69,12 @@ class Task:
         self._custom_reward = reward
         self.history_window = history_window
         self.start = start
+        # the arguments this task was built with (a flight spec records and rebuilds them)
+        self.options: dict[str, Any] = {
+            k: v
+            for k, v in (("reward", reward), ("history_window", history_window), ("start", start))
+            if v is not None and v != 0
+        }
         self._obs_idx = indices(self.observation_vars)
         self._n_vars = len(self.observation_vars)
         self.aircraft: Aircraft | None = None
@@ -149,9 +155,20 @@ class Task:
             return "above_ceiling"
         return None
 
-    def describe(self) -> dict[str, object]:
+    def tracked(self) -> dict[str, Any] | None:
+        """The one variable the task brings to a target, for the metrics and plots: its name
+        (``variable``), the observation entry holding target minus value (``error``), the
+        ``tolerance`` within which it counts as reached and whether the target moves
+        (``dynamic``); None for tasks without one."""
+        return None
+
+    def describe(self) -> dict[str, Any]:
         """What the task is, for logs and dataset metadata."""
-        return {"task": self.name, "observation": list(self.observation_names)}
+        return {
+            "task": self.name,
+            "observation": list(self.observation_names),
+            "tracked": self.tracked(),
+        }
 
     def _profile(self) -> FlightProfile:
         if self.aircraft is None:

@@ -20,7 +20,9 @@ it ``truncated``. The action is ``[aileron, elevator, rudder, throttle]``.
 
 from __future__ import annotations
 
+import importlib
 import math
+from typing import Any
 
 import numpy as np
 
@@ -180,6 +182,14 @@ class LevelFlightTask(Task):
         heading_err = (self.start_heading - state[_HDG] + 180.0) % 360.0 - 180.0
         return self.start_altitude - float(state[_ALT]), float(heading_err)
 
+    def tracked(self) -> dict[str, Any]:
+        return {
+            "variable": "altitude_ft",
+            "error": "altitude_ft_error",
+            "tolerance": self.altitude_tolerance,
+            "dynamic": False,
+        }
+
     def observe(self, state: np.ndarray, step: int) -> np.ndarray:
         n = self._n_vars
         obs = np.empty(n + 2, np.float32)
@@ -212,15 +222,47 @@ assert set(FAMILIES) <= set(TASK_FAMILIES)
 
 
 def task_class(name: str, dynamic: bool = False) -> type[Task]:
-    """The task class for a family name (``altitude``, ``roll``, ...), static or dynamic."""
+    """The task class for a family name (``altitude``, ``roll``, ...), static or dynamic, or
+    for an import path ``package.module:ClassName`` (a task of your own)."""
     from gymfg_il.errors import ConfigError
 
+    if isinstance(name, str) and ":" in name:
+        return _import_task(name)
     try:
         static, moving = TASK_FAMILIES[name]
-    except KeyError:
+    except (KeyError, TypeError):
         raise ConfigError(
-            f"unknown task {name!r}: choose one of {', '.join(TASK_FAMILIES)}"
+            f"unknown task {name!r}: choose one of {', '.join(TASK_FAMILIES)} (or give a task "
+            "of your own as 'package.module:ClassName')"
         ) from None
     if dynamic and static is moving:
         raise ConfigError(f"task {name!r} has no dynamic variant; drop --dynamic")
     return moving if dynamic else static
+
+
+def _import_task(path: str) -> type[Task]:
+    from gymfg_il.errors import ConfigError
+
+    module, _, qualname = path.partition(":")
+    try:
+        found: Any = importlib.import_module(module)
+        for part in qualname.split("."):
+            found = getattr(found, part)
+    except (ImportError, AttributeError) as err:
+        raise ConfigError(
+            f"cannot import task {path!r} ({err}); is its package installed?"
+        ) from None
+    if not (isinstance(found, type) and issubclass(found, Task)):
+        raise ConfigError(f"{path!r} is {found!r}, not a Task class")
+    return found
+
+
+def task_reference(cls: type[Task]) -> tuple[str, bool]:
+    """How a flight spec names a task class: (family name, dynamic) for the library's tasks,
+    (``package.module:ClassName``, False) for any other."""
+    for family, (static, moving) in TASK_FAMILIES.items():
+        if cls is static:
+            return family, False
+        if cls is moving:
+            return family, True
+    return f"{cls.__module__}:{cls.__qualname__}", False

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -71,7 +71,7 @@ class TargetTask(Task):
         target: a fixed target instead of a drawn one (an offset from the start value for
             relative families: altitude, heading, airspeed; an absolute value for roll, pitch).
         target_range: (low, high) to draw targets from, in the same convention.
-        hold_s: dynamic targets only: seconds between waypoints.
+        hold_s: dynamic targets only: seconds between waypoints (20 by default).
         reward_scale: error at which the reward's closeness term is 1/e.
         tolerance: error within which the target counts as reached (for success metrics).
         **kwargs: ``reward``, ``history_window`` and ``start`` of ``Task``.
@@ -85,12 +85,21 @@ class TargetTask(Task):
         *,
         target: float | None = None,
         target_range: tuple[float, float] | None = None,
-        hold_s: float = 20.0,
+        hold_s: float | None = None,
         reward_scale: float | None = None,
         tolerance: float | None = None,
         **kwargs: object,
     ) -> None:
         super().__init__(**kwargs)  # type: ignore[arg-type]
+        given = {
+            "target": target,
+            "target_range": target_range,
+            "hold_s": hold_s,
+            "reward_scale": reward_scale,
+            "tolerance": tolerance,
+        }
+        self.options.update({k: v for k, v in given.items() if v is not None})
+        hold_s = 20.0 if hold_s is None else hold_s
         fam = self.family
         self.target_range = tuple(target_range) if target_range is not None else fam.target_range
         problems = []
@@ -204,7 +213,16 @@ class TargetTask(Task):
         smooth = action_change(ctx.prev_action, ctx.action)
         return math.exp(-abs(err) / self.reward_scale) - SMOOTHNESS_WEIGHT * smooth
 
-    def describe(self) -> dict[str, object]:
+    def tracked(self) -> dict[str, Any]:
+        v = self.family.variable
+        return {
+            "variable": v,
+            "error": f"{v}_error",
+            "tolerance": self.tolerance,
+            "dynamic": self.dynamic,
+        }
+
+    def describe(self) -> dict[str, Any]:
         fam = self.family
         return {
             **super().describe(),

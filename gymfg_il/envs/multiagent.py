@@ -16,10 +16,12 @@ import numpy as np
 from pettingzoo import ParallelEnv
 
 from gymfg_il.envs.actions import Controls, controls
+from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.team import Team
-from gymfg_il.envs.world import EnvConfig, World
+from gymfg_il.envs.world import World
 from gymfg_il.errors import ActionError, EnvStateError
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW, BY_NAME
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 
 
 class GymFGParallelEnv(ParallelEnv):
@@ -110,8 +112,8 @@ class GymFGParallelEnv(ParallelEnv):
 def parallel_env(
     teams: Sequence[Team],
     *,
-    sim_hz: int = 120,
-    agent_hz: int = 10,
+    sim_hz: int = DEFAULT_SIM_HZ,
+    agent_hz: int = DEFAULT_AGENT_HZ,
     opponent_view: tuple[str, ...] | None = None,
     scenario: Any = None,
 ) -> GymFGParallelEnv:

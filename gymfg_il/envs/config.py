@@ -1,0 +1,63 @@
+"""What every environment is configured with: rates, the opponent view, a joint start, and
+the FlightGear views fed from the simulation."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from gymfg_il.envs.scenarios import Scenario
+from gymfg_il.errors import ConfigError
+from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
+from gymfg_il.viz.multiplayer import port_problem
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """Settings shared by every environment.
+
+    Args:
+        sim_hz: JSBSim rate (Hz).
+        agent_hz: agent rate (Hz); must divide ``sim_hz`` exactly; it is a dataset's fps.
+        opponent_view: the state variables an aircraft sees of other teams' aircraft
+            (position and orientation by default, as in the paper).
+        scenario: joint initial conditions overriding the tasks' own (see ``envs.scenarios``).
+        views: callsign -> UDP ports of FlightGear views of that aircraft. Only aircraft
+            listed here open a socket (the paper warns that a view per aircraft can load a
+            network); while any view is attached the simulation paces itself to real time.
+        traffic: callsign -> multiplayer UDP ports of the views of that aircraft
+            (``FlightGear(multiplayer_port=...)``): every other aircraft of the simulation,
+            opponents of an online client included, is sent there and appears in the view.
+    """
+
+    sim_hz: int = DEFAULT_SIM_HZ
+    agent_hz: int = DEFAULT_AGENT_HZ
+    opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW
+    scenario: Scenario | None = None
+    views: Mapping[str, Sequence[int]] | None = None
+    traffic: Mapping[str, Sequence[int]] | None = None
+
+    def __post_init__(self) -> None:
+        substeps(self.sim_hz, self.agent_hz)
+        problems = [
+            f"traffic of {c!r}: {problem}"
+            for c, ports in (self.traffic or {}).items()
+            for problem in map(port_problem, ports)
+            if problem
+        ]
+        if problems:
+            raise ConfigError("; ".join(problems))
+        view = tuple(self.opponent_view)
+        object.__setattr__(self, "opponent_view", view)
+        indices(view)
+        if len(set(view)) != len(view):
+            raise ConfigError(f"opponent_view lists a variable twice: {view}")
+        if self.scenario is not None and not callable(self.scenario):
+            raise ConfigError(
+                f"scenario must be callable (rng, aircraft) -> ics, got {self.scenario!r}"
+            )
+
+    @property
+    def dt(self) -> float:
+        return 1.0 / self.agent_hz

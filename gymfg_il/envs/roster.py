@@ -1,0 +1,136 @@
+"""Who flies in a flight spec, as plain data: each aircraft (``AircraftSpec``: model,
+callsign, task and the task's options) and each team (``TeamSpec``), and the conversion of
+task options to and from JSON-able values (``plain``, ``live``)."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from gymfg_il.aircraft import resolve_model
+from gymfg_il.errors import ConfigError
+from gymfg_il.sim.initial import InitialConditions
+from gymfg_il.tasks.base import Task
+from gymfg_il.tasks.library import TASK_FAMILIES, task_class
+
+UNBUILDABLE = "python:"  # marks a recorded value that cannot be rebuilt from the record
+
+
+def plain(value: Any) -> Any:
+    """A task option as JSON-able data (``InitialConditions`` as a tagged dict; anything that
+    is not data, such as a reward function, as ``"python:<name>"``)."""
+    if value is None or isinstance(value, (bool, int, str)):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else str(value)
+    if isinstance(value, InitialConditions):
+        return {"initial_conditions": dataclasses.asdict(value)}
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    if isinstance(value, Mapping):
+        return {str(k): plain(v) for k, v in value.items()}
+    if hasattr(value, "item") and callable(value.item):  # a numpy scalar
+        return plain(value.item())
+    name = getattr(value, "__qualname__", type(value).__qualname__)
+    return f"{UNBUILDABLE}{getattr(value, '__module__', '?')}.{name}"
+
+
+def live(value: Any) -> Any:
+    """The inverse of ``plain`` for what can be rebuilt."""
+    if isinstance(value, Mapping):
+        if set(value) == {"initial_conditions"}:
+            return InitialConditions(**value["initial_conditions"])
+        return {k: live(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [live(v) for v in value]
+    return value
+
+
+def unbuildable(value: Any) -> list[str]:
+    if isinstance(value, str):
+        return [value] if value.startswith(UNBUILDABLE) else []
+    if isinstance(value, Mapping):
+        return [u for v in value.values() for u in unbuildable(v)]
+    if isinstance(value, list):
+        return [u for v in value for u in unbuildable(v)]
+    return []
+
+
+@dataclass(frozen=True)
+class AircraftSpec:
+    """One aircraft of a flight.
+
+    Attributes:
+        model: JSBSim model (``c172p``, ``f15``, ``A320``, ...; case-insensitive).
+        callsign: its name in the simulation.
+        task: a task family (``altitude``, ``roll``, ``pitch``, ``heading``, ``airspeed``,
+            ``level``, ``dummy``) or a task class's import path ``package.module:ClassName``.
+        dynamic: the family's moving-target variant.
+        task_kwargs: the task's options as plain data (e.g. ``{"target_range": [-500, 500]}``).
+    """
+
+    model: str = "c172p"
+    callsign: str = "ego"
+    task: str = "altitude"
+    dynamic: bool = False
+    task_kwargs: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "model", resolve_model(self.model))
+        if not isinstance(self.callsign, str) or not self.callsign.strip():
+            raise ConfigError(f"callsign must be a non-empty string, got {self.callsign!r}")
+        if not isinstance(self.task_kwargs, Mapping):
+            raise ConfigError(f"task_kwargs must be a mapping, got {self.task_kwargs!r}")
+        object.__setattr__(self, "task_kwargs", plain(dict(self.task_kwargs)))
+        object.__setattr__(self, "dynamic", bool(self.dynamic))
+        library = self.task in TASK_FAMILIES or ":" not in str(self.task)
+        if library and not unbuildable(self.task_kwargs):
+            self.task_factory()()  # a library task is checked now: bad input fails at once
+
+    @property
+    def label(self) -> str:
+        """The task's short name: ``altitude``, ``roll-dynamic``, ..."""
+        return f"{self.task}-dynamic" if self.dynamic else self.task
+
+    def task_factory(self) -> Callable[[], Task]:
+        """A zero-argument factory of this aircraft's task (a Team roster entry)."""
+        bad = unbuildable(self.task_kwargs)
+        if bad:
+            raise ConfigError(
+                f"the task of {self.callsign!r} was flown with {bad}, which a record cannot "
+                "rebuild; pass the teams (or the env) that flew it"
+            )
+        return functools.partial(task_class(self.task, self.dynamic), **live(self.task_kwargs))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "model": self.model,
+            "callsign": self.callsign,
+            "task": self.task,
+            "dynamic": self.dynamic,
+            "task_kwargs": dict(self.task_kwargs),
+        }
+
+
+@dataclass(frozen=True)
+class TeamSpec:
+    """A team of a flight: its name, its aircraft, and whose states each one's reward sees
+    (``reward_targets``: callsign -> ((target callsign, target model), ...))."""
+
+    name: str
+    roster: tuple[AircraftSpec, ...]
+    reward_targets: Mapping[str, tuple[tuple[str, str], ...]] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "roster": [a.to_dict() for a in self.roster],
+            "reward_targets": {
+                owner: [{"callsign": c, "model": m} for c, m in targets]
+                for owner, targets in self.reward_targets.items()
+            },
+        }
