@@ -1,8 +1,8 @@
-"""Running seeded episodes across worker processes, with results identical to one worker.
+"""A process pool for seeded work, with results identical to one worker.
 
 Every episode depends only on its seed (the env is reset with it, the agent too), so seeds can
-be dealt to workers in any way; results come back in seed order. Workers build their own env
-and agents from picklable specs (``EnvSpec``, ``AgentSpec``) and keep them between episodes.
+be dealt to workers in any way; results come back in seed order. Workers build what they fly
+from picklable specs (``FlightSpec``, ``AgentSpec``) and keep it between episodes (``kept``).
 
 ``map_seeds(..., workers=2)`` starts a pool for the call; ``with Workers(2) as workers:``
 keeps one for several calls (evaluating several agents, rounds of episodes).
@@ -13,90 +13,11 @@ from __future__ import annotations
 import multiprocessing as mp
 import threading
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, TypeVar
 
-from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.errors import ConfigError, EnvStateError
 
 T = TypeVar("T")
-
-
-@dataclass(frozen=True)
-class EnvSpec:
-    """What builds an ``AircraftEnv``."""
-
-    task: str = "altitude"
-    aircraft: str = "c172p"
-    dynamic: bool = False
-    agent_hz: int = 10
-    episode_time_s: float = 90.0
-    task_kwargs: dict[str, Any] = field(default_factory=dict)
-    views: tuple[int, ...] = ()  # FlightGear UDP ports (real time while attached)
-
-    def make(self) -> AircraftEnv:
-        return AircraftEnv(
-            self.task,
-            self.aircraft,
-            dynamic=self.dynamic,
-            task_kwargs=self.task_kwargs,
-            agent_hz=self.agent_hz,
-            episode_time_s=self.episode_time_s,
-            views=self.views or None,
-        )
-
-
-@dataclass(frozen=True)
-class AgentSpec:
-    """What builds an agent for an env: the task's controller or a policy checkpoint."""
-
-    kind: str
-    path: Path | None = None
-
-    @classmethod
-    def controller(cls) -> AgentSpec:
-        return cls("controller")
-
-    @classmethod
-    def policy(cls, path: Path) -> AgentSpec:
-        return cls("policy", Path(path))
-
-    def key(self) -> str:
-        """What a worker's cache knows this agent by: its spec, and for a checkpoint the
-        time and size of its config and weights (one retrained in place is loaded afresh)."""
-        if self.path is None:
-            return repr(self)
-        from gymfg_il.policies.factory import CONFIG_FILE, WEIGHTS_FILE
-
-        stamps: list[tuple[int, int] | None] = []
-        for name in (CONFIG_FILE, WEIGHTS_FILE):
-            try:
-                st = (self.path / name).stat()
-                stamps.append((st.st_mtime_ns, st.st_size))
-            except OSError:
-                stamps.append(None)  # loading it will say what is missing
-        return repr((self, stamps))
-
-    def meta(self) -> dict[str, Any]:
-        from gymfg_il.policies.factory import read_config
-
-        assert self.path is not None
-        return read_config(self.path)
-
-    def make(self, env: AircraftEnv) -> Any:
-        if self.kind == "controller":
-            from gymfg_il.controllers.autopilot import controller_for
-
-            return controller_for(
-                env.task, env.aircraft.model, env.dt, env.aircraft.profile.cruise_throttle
-            )
-        from gymfg_il.policies.agent import PolicyAgent
-
-        assert self.path is not None
-        agent = PolicyAgent.load(self.path)
-        agent.check_observation(env.observation_names)
-        return agent
 
 
 # What this process flies with, kept between episodes (in a worker, between calls too):
@@ -147,9 +68,7 @@ def _start_method() -> str:
     if "fork" in methods and threading.active_count() == 1:
         return "fork"
     if "forkserver" in methods:
-        mp.set_forkserver_preload(
-            ["gymfg_il.parallel", "gymfg_il.evaluation.parallel", "gymfg_il.collectors.session"]
-        )
+        mp.set_forkserver_preload(["gymfg_il.workers", "gymfg_il.rollout.seeded"])
         return "forkserver"
     return "spawn"
 

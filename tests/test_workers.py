@@ -6,14 +6,15 @@ import pytest
 
 from gymfg_il.collectors.autopilot import record_autopilot
 from gymfg_il.collectors.config import CollectConfig
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, EnvStateError
-from gymfg_il.evaluation.parallel import fly_many
-from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, map_seeds
 from gymfg_il.recording.reader import read_log
+from gymfg_il.rollout import AgentSpec, fly_many
+from gymfg_il.workers import Workers, map_seeds
 
 
 def test_two_workers_give_what_one_gives(tmp_path):
-    spec = EnvSpec("roll", "f15", dynamic=True, episode_time_s=10)
+    spec = FlightSpec.solo("f15", "roll", dynamic=True, episode_time_s=10)
     one = fly_many(spec, AgentSpec.controller(), [4, 5, 6], workers=1)
     two = fly_many(spec, AgentSpec.controller(), [4, 5, 6], workers=2)
     assert [e.seed for e in two] == [4, 5, 6]
@@ -31,7 +32,7 @@ def test_two_workers_give_what_one_gives(tmp_path):
 
 
 def test_kept_workers_serve_several_calls_alike_and_refuse_use_after_close(tmp_path):
-    spec = EnvSpec("roll", "c172p", episode_time_s=5)
+    spec = FlightSpec.solo("c172p", "roll", episode_time_s=5)
     one = fly_many(spec, AgentSpec.controller(), [1, 2, 3], workers=1)
     # fork while this process runs no other thread (an earlier test's tqdm monitor may)
     expected = "fork" if threading.active_count() == 1 else "forkserver"
@@ -39,7 +40,7 @@ def test_kept_workers_serve_several_calls_alike_and_refuse_use_after_close(tmp_p
         assert workers._pool._ctx.get_start_method() == expected
         first = fly_many(spec, AgentSpec.controller(), [1, 2, 3], workers=workers)
         other = fly_many(
-            EnvSpec("pitch", episode_time_s=5), AgentSpec.controller(), [1, 2], workers
+            FlightSpec.solo(task="pitch", episode_time_s=5), AgentSpec.controller(), [1, 2], workers
         )
         again = fly_many(spec, AgentSpec.controller(), [3, 2, 1], workers=workers)
         pending = map_seeds(operator.add, (10,), [1, 2, 3], workers)

@@ -1,2 +1,3 @@
-"""Manual flying: pygame input devices, the ManualController, the controls GUI, and the
-real-time collection session."""
+"""Flying by hand: pygame input devices and their bindings, the ManualController (a person as
+an Agent), the controls GUI, and Takeover (a person sharing the controls with an assistant).
+The real-time collection session that uses them is ``gymfg_il.collectors.manual``."""

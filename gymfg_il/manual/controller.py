@@ -14,6 +14,7 @@ import numpy as np
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.manual.bindings import JoystickBindings, KeyboardBindings, MouseBindings
+from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
 
 DEVICES = ("keyboard", "mouse", "joystick")
 
@@ -133,7 +134,7 @@ class ManualController:
                 if keyboard_axis and not moved[idx]:
                     v = self.values[idx]
                     self.values[idx] = 0.0 if abs(v) <= step else v - step * np.sign(v)
-        np.clip(self.values, [-1.0, -1.0, -1.0, 0.0], 1.0, out=self.values)
+        np.clip(self.values, ACTION_LOW, ACTION_HIGH, out=self.values)
 
     def _mouse(self, pos: tuple[int, int]) -> None:
         m = self.mouse

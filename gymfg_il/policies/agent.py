@@ -1,5 +1,5 @@
-"""A trained policy as an Agent: numpy observation in, clipped action out, memory reset
-at every episode."""
+"""A trained policy as an Agent: numpy observation in, action out, memory reset at every
+episode."""
 
 from __future__ import annotations
 
@@ -23,8 +23,6 @@ class PolicyAgent:
         self.observation_names: list[str] = list(meta["observation_names"])
         self._torch = torch
         self._state: object = None
-        self._low = np.array([-1.0, -1.0, -1.0, 0.0])
-        self._high = np.ones(4)
 
     @classmethod
     def load(cls, path: Path, device: str = "cpu") -> PolicyAgent:
@@ -52,4 +50,6 @@ class PolicyAgent:
         torch = self._torch
         obs = torch.as_tensor(np.asarray(observation, dtype=np.float32), device=self.device)
         action, self._state = self.policy.act(obs.unsqueeze(0), self._state)
-        return np.clip(action[0].double().cpu().numpy(), self._low, self._high)
+        # the raw action: the rollout loop (or the env) clips it to the contract
+        out: np.ndarray = action[0].double().cpu().numpy()
+        return out

@@ -1,0 +1,50 @@
+"""A person and an assistant sharing the controls: the assistant (the task's controller or a
+policy) flies until the person takes over, and again after they hand back."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gymfg_il.controllers.agent import Agent
+from gymfg_il.manual.controller import ManualController
+
+
+class Takeover:
+    """An Agent: the person (``human``) flies, or ``assistant`` while the person lets it.
+
+    While the person flies, an assistant with ``track`` follows their inputs, so handing back
+    is bumpless; ``intervening`` tells the rollout loop to flag those steps.
+    """
+
+    def __init__(self, human: ManualController, assistant: Agent | None = None) -> None:
+        self.human, self.assistant = human, assistant
+        self.human_flies = assistant is None
+
+    @property
+    def intervening(self) -> bool:
+        """A person flies while an assistant was ready to."""
+        return self.assistant is not None and self.human_flies
+
+    def toggle(self, last_action: np.ndarray) -> None:
+        """Take over (the stick starts where the assistant had it) or hand back."""
+        if self.assistant is None:
+            return
+        self.human_flies = not self.human_flies
+        if self.human_flies:
+            self.human.values[:] = last_action
+
+    def reset(self, seed: int | None = None) -> None:
+        self.human.reset(seed)
+        if self.assistant is not None:
+            self.assistant.reset(seed)
+
+    def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        if self.human_flies:
+            action = self.human.act(observation)
+            track = getattr(self.assistant, "track", None)
+            if self.assistant is not None and track is not None:
+                self.assistant.act(observation)
+                track(action)  # its integrators follow the person: a bumpless hand-back
+            return action
+        assert self.assistant is not None
+        return self.assistant.act(observation, opponent_states)

@@ -1,0 +1,64 @@
+"""What builds an agent for an env, picklable so a worker process can build it too: the
+task's physics-based controller, or a trained policy checkpoint."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from gymfg_il.controllers.agent import Agent
+from gymfg_il.envs.single import AircraftEnv
+
+
+@dataclass(frozen=True)
+class AgentSpec:
+    """``AgentSpec.controller()`` or ``AgentSpec.policy(path)``."""
+
+    kind: str
+    path: Path | None = None
+
+    @classmethod
+    def controller(cls) -> AgentSpec:
+        return cls("controller")
+
+    @classmethod
+    def policy(cls, path: Path) -> AgentSpec:
+        return cls("policy", Path(path))
+
+    def key(self) -> str:
+        """What a worker's cache knows this agent by: its spec, and for a checkpoint the
+        time and size of its config and weights (one retrained in place is loaded afresh)."""
+        if self.path is None:
+            return repr(self)
+        from gymfg_il.policies.factory import CONFIG_FILE, WEIGHTS_FILE
+
+        stamps: list[tuple[int, int] | None] = []
+        for name in (CONFIG_FILE, WEIGHTS_FILE):
+            try:
+                st = (self.path / name).stat()
+                stamps.append((st.st_mtime_ns, st.st_size))
+            except OSError:
+                stamps.append(None)  # loading it will say what is missing
+        return repr((self, stamps))
+
+    def meta(self) -> dict[str, Any]:
+        """A policy's ``config.json``."""
+        from gymfg_il.policies.factory import read_config
+
+        assert self.path is not None
+        return read_config(self.path)
+
+    def make(self, env: AircraftEnv) -> Agent:
+        if self.kind == "controller":
+            from gymfg_il.controllers.autopilot import controller_for
+
+            return controller_for(
+                env.task, env.aircraft.model, env.dt, env.aircraft.profile.cruise_throttle
+            )
+        from gymfg_il.policies.agent import PolicyAgent
+
+        assert self.path is not None
+        agent = PolicyAgent.load(self.path)
+        agent.check_observation(env.observation_names)
+        return agent
