@@ -17,8 +17,11 @@ from mcap.exceptions import McapError
 from mcap.records import Channel, Chunk, Message, Metadata
 from mcap.stream_reader import StreamReader
 
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import GymFGError
-from gymfg_il.recording.writer import EPISODE_TOPIC, SESSION_METADATA
+from gymfg_il.recording.session import SESSION_METADATA, spec_of, upgrade
+from gymfg_il.recording.writer import EPISODE_TOPIC
+from gymfg_il.rollout.records import OpponentView
 from gymfg_il.sim.properties import ACTION_NAMES, NAMES
 
 
@@ -62,10 +65,26 @@ class LoggedEpisode:
     end: dict[str, Any] | None = None
     discarded: bool = False
     steps: dict[str, AircraftSteps] = field(default_factory=dict)
+    raw_views: dict[str, list[bytes]] = field(default_factory=dict, repr=False)
 
     @property
     def complete(self) -> bool:
         return self.end is not None and not self.discarded
+
+    def start_of(self, callsign: str) -> dict[str, Any]:
+        """``callsign``'s start: ``target`` and ``initial_state`` (older logs: the episode's)."""
+        aircraft = self.start.get("aircraft")
+        if isinstance(aircraft, dict) and callsign in aircraft:
+            return dict(aircraft[callsign])
+        return {k: self.start[k] for k in ("target", "initial_state") if k in self.start}
+
+    def views(self, team: str) -> list[OpponentView]:
+        """What ``team`` saw of the other teams after each step (team runs)."""
+        rows = [orjson.loads(b) for b in self.raw_views.get(team, [])]
+        return [
+            OpponentView(r["callsigns"], tuple(r["names"]), np.array(r["values"], np.float64))
+            for r in rows
+        ]
 
 
 @dataclass
@@ -78,6 +97,19 @@ class Log:
     @property
     def complete_episodes(self) -> list[LoggedEpisode]:
         return [e for e in self.episodes if e.complete]
+
+    @property
+    def spec(self) -> FlightSpec:
+        """The flight spec the log was recorded with."""
+        return spec_of(self.session)
+
+    def aircraft(self, callsign: str) -> dict[str, Any]:
+        """What the session record says of ``callsign``: team, model, task, observation
+        names, task description."""
+        try:
+            return dict(self.session["aircraft"][callsign])
+        except (KeyError, TypeError):
+            raise LogError(f"{self.path.name} records no aircraft {callsign!r}") from None
 
 
 def _steps(rows: list[dict[str, Any]], states: list[bytes]) -> AircraftSteps:
@@ -144,15 +176,19 @@ class _Collector:
         self.events: list[dict[str, Any]] = []
         self.rows: dict[tuple[int, str], list[dict[str, Any]]] = {}
         self.states: dict[tuple[int, str], list[bytes]] = {}
+        self.views: dict[tuple[int, str], list[bytes]] = {}
         self._last: dict[str, tuple[int, str]] = {}
+        self._episode = -1
 
     def channel(self, channel_id: int, topic: str) -> None:
         if topic == EPISODE_TOPIC:
             self.kinds[channel_id] = ("episode", "")
-        else:
-            parts = topic.split("/")
-            if len(parts) == 4 and parts[1] == "gymfg" and parts[3] in ("step", "state"):
-                self.kinds[channel_id] = (parts[3], parts[2])
+            return
+        parts = topic.split("/")
+        if len(parts) == 4 and parts[1] == "gymfg" and parts[3] in ("step", "state"):
+            self.kinds[channel_id] = (parts[3], parts[2])
+        elif len(parts) == 5 and parts[1:3] == ["gymfg", "team"] and parts[4] == "opponents":
+            self.kinds[channel_id] = ("view", parts[3])
 
     def message(self, channel_id: int, data: bytes) -> None:
         kind = self.kinds.get(channel_id)
@@ -169,8 +205,12 @@ class _Collector:
             last = self._last.get(callsign)
             if last is not None:
                 self.states.setdefault(last, []).append(data)
+        elif what == "view":  # written after the steps of its tick: same episode
+            self.views.setdefault((self._episode, callsign), []).append(data)
         else:
-            self.events.append(orjson.loads(data))
+            event = orjson.loads(data)
+            self._episode = int(event.get("episode", -1))
+            self.events.append(event)
 
 
 def _stream(path: Path, seen: _Collector) -> tuple[dict[str, Any] | None, bool]:
@@ -215,6 +255,7 @@ def read_log(path: Path) -> Log:
             gc.enable()
     if session is None:
         raise LogError(f"{path} has no {SESSION_METADATA} record: not a GymFG trajectory log")
+    session = upgrade(session)
     events, rows, states = seen.events, seen.rows, seen.states
     episodes: dict[int, LoggedEpisode] = {}
     for ev in events:
@@ -228,4 +269,7 @@ def read_log(path: Path) -> Log:
     for (k, callsign), msgs in rows.items():
         if k in episodes:
             episodes[k].steps[callsign] = _steps(msgs, states.get((k, callsign), []))
+    for (k, team), views in seen.views.items():
+        if k in episodes:
+            episodes[k].raw_views[team] = views
     return Log(path, session, [episodes[k] for k in sorted(episodes)], finished)

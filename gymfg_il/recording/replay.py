@@ -1,74 +1,121 @@
 """Re-flying a recorded episode through JSBSim from its seed and actions.
 
-The environment is rebuilt from the session record, reset with the episode's seed, and driven
-with the logged (executed) actions; every state must match the log bit for bit.
+The world is rebuilt from the log's flight spec (every team and aircraft), reset with the
+episode's seed, and every aircraft is driven with its logged (executed) actions; every state
+must match the log bit for bit. A team run whose tasks or scenario the record cannot rebuild
+(a reward lambda, a scenario of your own) is replayed by passing the teams or the scenario
+that flew it.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+import dataclasses
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from gymfg_il.envs.single import AircraftEnv
+from gymfg_il.envs.actions import Controls
+from gymfg_il.envs.scenarios import Scenario
+from gymfg_il.envs.team import Team
+from gymfg_il.envs.world import World
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import Log, LoggedEpisode
 
 
 @dataclass
 class ReplayResult:
+    """How the re-flown episode compares with the log (all aircraft, or the one asked for).
+
+    ``per_aircraft`` holds each callsign's (identical, first mismatching step)."""
+
     episode: int
     steps: int
     identical: bool
     max_abs_diff: float
     first_mismatch: int | None
+    per_aircraft: dict[str, tuple[bool, int | None]] = field(default_factory=dict)
 
 
-def env_from_session(session: dict[str, object], views: list[int] | None = None) -> AircraftEnv:
-    spec = session.get("env")
-    if not isinstance(spec, dict):
-        raise ConfigError("the log's session record has no env spec; it cannot be replayed")
-    return AircraftEnv(
-        spec["task"],
-        spec["aircraft"],
-        dynamic=bool(spec["dynamic"]),
-        task_kwargs=spec.get("task_kwargs") or {},
-        agent_hz=int(spec["agent_hz"]),
-        sim_hz=int(spec["sim_hz"]),
-        episode_time_s=float(spec["episode_time_s"]),
-        views=views,
-    )
+def world_for(
+    log: Log,
+    views: Sequence[int] | None = None,
+    teams: list[Team] | None = None,
+    scenario: Scenario | None = None,
+) -> World:
+    """The world a log was flown in (``views``: FlightGear ports showing the first aircraft;
+    ``teams``/``scenario``: the objects that flew it, where the record cannot rebuild them)."""
+    spec = log.spec
+    problems = [] if teams is not None else spec.rebuild_problems()
+    if scenario is None and str((spec.scenario or {}).get("name", "")).startswith("python:"):
+        problems.append(f"scenario {spec.scenario}")
+    if problems:
+        raise ConfigError(
+            f"{log.path.name} cannot be rebuilt from its record ({'; '.join(problems)}); "
+            "pass the teams= and scenario= that flew it"
+        )
+    config = spec.env_config(scenario=scenario)
+    if views:
+        first = spec.aircraft_specs[0].callsign
+        config = dataclasses.replace(config, views={first: list(views)})
+    online = bool(log.session.get("online"))
+    return World(teams or spec.build_teams(), config, external_targets=online)
 
 
 def replay_episode(
     log: Log,
     episode: LoggedEpisode,
-    callsign: str = "ego",
-    env: AircraftEnv | None = None,
-    on_step: Callable[[AircraftEnv, int], None] | None = None,
+    callsign: str | None = None,
+    world: World | None = None,
+    on_step: Callable[[World, int], None] | None = None,
 ) -> ReplayResult:
-    """Re-fly ``episode`` and compare every state with the log; ``on_step`` (a viewer such
-    as the GUI or FlightGear) is called after each step."""
-    if callsign not in episode.steps:
+    """Re-fly ``episode`` and compare every aircraft's states with the log (``callsign``:
+    judge that one only); ``on_step`` (a viewer such as FlightGear) is called after each
+    step."""
+    if callsign is not None and callsign not in episode.steps:
         raise ConfigError(f"episode {episode.index} has no steps of {callsign!r}")
-    steps = episode.steps[callsign]
-    own = env is None
-    env = env or env_from_session(log.session)
+    own = world is None
+    world = world or world_for(log)
     try:
-        env.reset(seed=int(episode.start["seed"]))
-        slot = env.world.slots[0]
-        logged = steps.state
-        worst, first = 0.0, None
-        for i, action in enumerate(steps.action):
-            env.step(action)
-            diff = np.abs(slot.state - logged[i])
-            if first is None and not np.array_equal(slot.state, logged[i]):
-                first = i
-            worst = max(worst, float(np.nanmax(diff)))
+        missing = sorted(set(episode.steps) - set(world.by_callsign))
+        if missing:
+            raise ConfigError(f"the world has no aircraft {missing} that the log flew")
+        world.reset(np.random.default_rng(int(episode.start["seed"])))
+        logged = {c: (s.action, s.state) for c, s in episode.steps.items()}
+        length = max(len(s) for s in episode.steps.values())
+        judged = [callsign] if callsign is not None else sorted(logged)
+        first: dict[str, int | None] = dict.fromkeys(judged)
+        worst = 0.0
+        for i in range(length):
+            actions: list[Controls | None] = []
+            for slot in world.slots:
+                flown = logged.get(slot.callsign)
+                if flown is None or i >= len(flown[0]):
+                    actions.append(None)
+                else:
+                    a0, a1, a2, a3 = flown[0][i].tolist()
+                    actions.append((a0, a1, a2, a3))
+            world.advance(actions)
+            for c in judged:
+                states = logged[c][1]
+                if i >= len(states):
+                    continue
+                state = world.by_callsign[c].state
+                if first[c] is None and not np.array_equal(state, states[i]):
+                    first[c] = i
+                worst = max(worst, float(np.nanmax(np.abs(state - states[i]))))
             if on_step is not None:
-                on_step(env, i)
+                on_step(world, i)
     finally:
         if own:
-            env.close()
-    return ReplayResult(episode.index, len(steps), first is None, worst, first)
+            world.close()
+            world.pool.close()
+    mismatches = [f for f in first.values() if f is not None]
+    return ReplayResult(
+        episode.index,
+        len(episode.steps[judged[0]]) if callsign is not None else length,
+        not mismatches,
+        worst,
+        min(mismatches) if mismatches else None,
+        {c: (f is None, f) for c, f in first.items()},
+    )

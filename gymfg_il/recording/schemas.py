@@ -2,15 +2,18 @@
 
 Channels (Foxglove conventions: JSON messages with a ``jsonschema`` schema):
 
-- ``/gymfg/episode`` (``gymfg.EpisodeEvent``): start (seed, task, target, initial state),
-  end (outcome), discard.
+- ``/gymfg/episode`` (``gymfg.EpisodeEvent``): start (seed, source, and per aircraft its
+  target and initial position), end (outcome), discard.
 - ``/gymfg/<callsign>/step`` (``gymfg.Step``): every agent step: observation, action, label
   (the demonstrator's action), reward, flags.
 - ``/gymfg/<callsign>/state`` (``gymfg.State``): the full state after every step.
 - ``/gymfg/<callsign>/location`` (``foxglove.LocationFix``): position for Foxglove's map.
+- ``/gymfg/team/<team>/opponents`` (``gymfg.OpponentView``): what a team saw of the other
+  teams after every step (team runs only).
 
-Session metadata (aircraft, task, rates, package versions) is an MCAP metadata record named
-``gymfg.session``.
+Session metadata (the flight spec, each aircraft's task and observation names, the source,
+package versions) is an MCAP metadata record named ``gymfg.session``
+(``recording.session``).
 """
 
 from __future__ import annotations
@@ -19,8 +22,6 @@ import json
 from collections.abc import Mapping
 
 from gymfg_il.sim.properties import ACTION_NAMES, CATALOGUE
-
-SCHEMA_VERSION = 1
 
 _ACTION = {
     "type": "object",
@@ -71,15 +72,29 @@ EPISODE_EVENT = {
         "event": {"type": "string", "enum": ["start", "end", "discard"]},
         "episode": {"type": "integer"},
         "seed": {"type": "integer"},
-        "task": {"type": "object"},
-        "target": {"type": ["number", "null"]},
-        "initial_state": {"type": "object"},
+        "aircraft": {
+            "type": "object",
+            "description": "callsign -> target and initial_state (lat_deg, lon_deg, altitude_ft)",
+        },
         "outcome": {"type": "string"},
         "steps": {"type": "integer"},
         "source": {"type": "string"},
         "interventions": {"type": "integer"},
     },
     "required": ["event", "episode"],
+}
+
+OPPONENT_VIEW = {
+    "title": "gymfg.OpponentView",
+    "type": "object",
+    "description": "what a team saw of the other teams' aircraft after a step",
+    "properties": {
+        "episode": {"type": "integer"},
+        "step": {"type": "integer"},
+        "names": {"type": "array", "items": {"type": "string"}},
+        "callsigns": {"type": "array", "items": {"type": "string"}},
+        "values": {"type": "array", "items": {"type": "array", "items": {"type": "number"}}},
+    },
 }
 
 # Foxglove's built-in schema is matched by its exact name.

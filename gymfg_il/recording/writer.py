@@ -3,6 +3,10 @@
 The log is the write-ahead log of a collection session: the chunk in progress is finished,
 flushed and fsynced at every episode boundary, so ``kill -9`` at any moment loses at most the
 episode in progress; ``recording.reader`` reads what an unfinished file holds.
+
+It takes the rollout loop's records: ``log_tick`` one step of the flight at a time (the manual
+session, a recorded team run) or ``write_episode`` a whole flown episode (collection on
+workers). Both end in the same messages.
 """
 
 from __future__ import annotations
@@ -10,7 +14,7 @@ from __future__ import annotations
 import json
 import os
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -18,11 +22,13 @@ import numpy as np
 from mcap.writer import CompressionType, IndexType, Writer
 
 from gymfg_il.recording import schemas
+from gymfg_il.recording.session import SESSION_METADATA
+from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
 from gymfg_il.sim.properties import ACTION_NAMES, NAMES
 
-SESSION_METADATA = "gymfg.session"
 EPISODE_TOPIC = "/gymfg/episode"
 _FT_TO_M = 0.3048
+_INITIAL = ("lat_deg", "lon_deg", "altitude_ft")
 
 
 def step_topic(callsign: str) -> str:
@@ -37,17 +43,8 @@ def location_topic(callsign: str) -> str:
     return f"/gymfg/{callsign}/location"
 
 
-def package_versions() -> dict[str, str]:
-    """Versions of the packages a log's contents depend on."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    out = {}
-    for name in ("gymfg-il", "jsbsim", "gymnasium", "mcap", "numpy", "lerobot"):
-        try:
-            out[name] = version(name)
-        except PackageNotFoundError:
-            out[name] = "absent"
-    return out
+def view_topic(team: str) -> str:
+    return f"/gymfg/team/{team}/opponents"
 
 
 class TrajectoryWriter:
@@ -55,68 +52,63 @@ class TrajectoryWriter:
 
     Args:
         path: the ``.mcap`` file to create.
-        session: what the session is (env spec, aircraft, task, rates, source); stored as the
-            ``gymfg.session`` metadata record, values JSON-encoded.
-        callsigns: the aircraft whose steps will be logged.
-        dt: seconds per agent step (the log's clock advances by it per step).
+        session: the session record (``recording.session.session_record``): the flight
+            spec, its aircraft and where the data comes from.
         chunk_size: bytes per MCAP chunk; small chunks bound what a crash can lose.
     """
 
     def __init__(
-        self,
-        path: Path,
-        session: Mapping[str, Any],
-        callsigns: list[str],
-        dt: float,
-        chunk_size: int = 256 * 1024,
+        self, path: Path, session: Mapping[str, Any], chunk_size: int = 256 * 1024
     ) -> None:
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         self.path = path
         self._file: BinaryIO = open(path, "xb")  # noqa: SIM115 (closed in close())
+        try:
+            self._open(session, chunk_size)
+        except BaseException:
+            self._file.close()
+            path.unlink()
+            raise
+
+    def _open(self, session: Mapping[str, Any], chunk_size: int) -> None:
+        callsigns = list(session["callsigns"])
+        teams = sorted({a["team"] for a in session["aircraft"].values()})
         # Chunk indexes only: per-message indexes would double the records a reader walks,
         # and chunk indexes are what viewers use to seek.
-        self._writer = Writer(
+        w = self._writer = Writer(
             self._file,
             chunk_size=chunk_size,
             compression=CompressionType.ZSTD,
             index_types=IndexType.CHUNK | IndexType.ATTACHMENT | IndexType.METADATA,
         )
-        self._writer.start(profile="", library="gymfg-il")
-        step_schema = self._writer.register_schema(
-            "gymfg.Step", "jsonschema", schemas.encoded(schemas.STEP)
+        w.start(profile="", library="gymfg-il")
+
+        def schema(name: str, body: Mapping[str, object]) -> int:
+            return w.register_schema(name, "jsonschema", schemas.encoded(body))
+
+        step, event, state = (
+            schema("gymfg.Step", schemas.STEP),
+            schema("gymfg.EpisodeEvent", schemas.EPISODE_EVENT),
+            schema("gymfg.State", schemas.STATE),
         )
-        event_schema = self._writer.register_schema(
-            "gymfg.EpisodeEvent", "jsonschema", schemas.encoded(schemas.EPISODE_EVENT)
+        fix, view = (
+            schema("foxglove.LocationFix", schemas.LOCATION_FIX),
+            schema("gymfg.OpponentView", schemas.OPPONENT_VIEW),
         )
-        state_schema = self._writer.register_schema(
-            "gymfg.State", "jsonschema", schemas.encoded(schemas.STATE)
+        self._events = w.register_channel(EPISODE_TOPIC, "json", event)
+        self._steps = {c: w.register_channel(step_topic(c), "json", step) for c in callsigns}
+        self._states = {c: w.register_channel(state_topic(c), "json", state) for c in callsigns}
+        self._fixes = {c: w.register_channel(location_topic(c), "json", fix) for c in callsigns}
+        self._views = (
+            {t: w.register_channel(view_topic(t), "json", view) for t in teams}
+            if len(teams) > 1 or session.get("online")
+            else {}
         )
-        fix_schema = self._writer.register_schema(
-            "foxglove.LocationFix", "jsonschema", schemas.encoded(schemas.LOCATION_FIX)
-        )
-        self._events = self._writer.register_channel(EPISODE_TOPIC, "json", event_schema)
-        self._steps = {
-            c: self._writer.register_channel(step_topic(c), "json", step_schema) for c in callsigns
-        }
-        self._states = {
-            c: self._writer.register_channel(state_topic(c), "json", state_schema)
-            for c in callsigns
-        }
-        self._fixes = {
-            c: self._writer.register_channel(location_topic(c), "json", fix_schema)
-            for c in callsigns
-        }
-        meta = {
-            "schema_version": schemas.SCHEMA_VERSION,
-            "versions": package_versions(),
-            "callsigns": callsigns,
-            "dt": dt,
-            **session,
-        }
-        self._writer.add_metadata(SESSION_METADATA, {k: json.dumps(v) for k, v in meta.items()})
-        self._dt_ns = round(dt * 1e9)
+        w.add_metadata(SESSION_METADATA, {k: json.dumps(v) for k, v in session.items()})
+        self._dt_ns = round(float(session["dt"]) * 1e9)
         self._clock_ns = time.time_ns()
+        self._base_ns = self._clock_ns  # the log time of the current episode's reset
         self._sequence = 0
         self.episode = -1
         self._in_episode = False
@@ -136,14 +128,66 @@ class TrajectoryWriter:
             sequence=self._sequence,
         )
 
-    def start_episode(self, **info: Any) -> int:
-        """Open the next episode; ``info`` holds seed, task, target, initial state, source."""
+    def _at_step(self, step: int) -> None:
+        """Set the log's clock to agent step ``step`` of this episode."""
+        self._clock_ns = self._base_ns + step * self._dt_ns
+
+    # -- episodes ------------------------------------------------------------------------
+    def start_episode(self, seed: int, starts: Sequence[Start], **info: Any) -> int:
+        """Open the next episode: its seed, every aircraft's start (target, position) and
+        ``info`` (source, iteration, ...)."""
         if self._in_episode:
             raise RuntimeError("end or discard the current episode before starting another")
         self.episode += 1
         self._in_episode = True
-        self._emit(self._events, {"event": "start", "episode": self.episode, **info})
+        self._base_ns = self._clock_ns
+        aircraft = {
+            s.callsign: {
+                "target": s.target,
+                "initial_state": dict(zip(_INITIAL, s.state[:3].tolist(), strict=True)),
+            }
+            for s in starts
+        }
+        event = {"event": "start", "episode": self.episode, "seed": seed, "aircraft": aircraft}
+        self._emit(self._events, {**event, **info})
         return self.episode
+
+    def log_tick(self, tick: Tick) -> None:
+        """Log one agent step of the flight: every aircraft's step and each team's view."""
+        self._at_step(tick.step)
+        for s in tick.steps:
+            self.log_step(
+                s.callsign, s.step, s.state, s.observation, s.action, s.label, s.reward,
+                s.terminated, s.truncated, s.intervention,
+            )  # fmt: skip
+        for team, view in tick.views.items():
+            self.log_view(team, tick.step, view)
+
+    def write_episode(self, episode: Episode, **info: Any) -> None:
+        """Log a whole flown episode and make it durable (``info``: source, iteration). The
+        messages come in the order ``log_tick`` would have written them."""
+        trajectories = list(episode.trajectories.values())
+        self.start_episode(episode.seed, [t.start for t in trajectories], **info)
+        steps = max((len(t) for t in trajectories), default=0)
+        for k in range(steps):
+            self._at_step(k + 1)
+            for t in trajectories:
+                if k >= len(t):
+                    continue
+                last = k == len(t) - 1
+                self.log_step(
+                    t.callsign, k + 1, t.states[k], t.observations[k], t.actions[k], t.labels[k],
+                    t.rewards[k], t.terminated and last,
+                    episode.truncated and last and not t.terminated,
+                    bool(t.interventions[k]),
+                )  # fmt: skip
+            for team, views in episode.views.items():
+                self.log_view(team, k + 1, views[k])
+        self.end_episode(
+            outcome=episode.outcome,
+            steps=steps,
+            interventions=int(sum(t.interventions.sum() for t in trajectories)),
+        )
 
     def log_step(
         self,
@@ -151,15 +195,14 @@ class TrajectoryWriter:
         step: int,
         state: np.ndarray,
         observation: np.ndarray,
-        action: tuple[float, ...] | np.ndarray,
-        label: tuple[float, ...] | np.ndarray,
+        action: Sequence[float] | np.ndarray,
+        label: Sequence[float] | np.ndarray,
         reward: float,
         terminated: bool = False,
         truncated: bool = False,
         intervention: bool = False,
     ) -> None:
         """Log one agent step of ``callsign`` (state after the step, action that led to it)."""
-        self._clock_ns += self._dt_ns
         values = state.tolist()
         self._emit(
             self._steps[callsign],
@@ -191,6 +234,22 @@ class TrajectoryWriter:
                 "altitude": values[2] * _FT_TO_M,
                 "position_covariance": [0.0] * 9,
                 "position_covariance_type": 0,
+            },
+        )
+
+    def log_view(self, team: str, step: int, view: OpponentView) -> None:
+        """Log what ``team`` saw of the other teams after agent step ``step``."""
+        channel = self._views.get(team)
+        if channel is None:
+            return
+        self._emit(
+            channel,
+            {
+                "episode": self.episode,
+                "step": step,
+                "names": list(view.names),
+                "callsigns": list(view.callsigns),
+                "values": np.asarray(view.values, dtype=np.float64).tolist(),
             },
         )
 

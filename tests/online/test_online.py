@@ -87,7 +87,7 @@ def test_online_run_matches_the_offline_env_bit_for_bit(server, tmp_path):
     teams = run_team.teams(6)
     blue_states = []
     # the same two teams in one offline simulation, seeded alike
-    from gymfg_il.envs.world import EnvConfig, World
+    from gymfg_il.envs import EnvConfig, World
 
     world = World([teams["red"], teams["blue"]], EnvConfig())
     world.reset(np.random.default_rng(5))
@@ -483,3 +483,30 @@ def test_a_team_that_leaves_holds_up_no_one(server):
     thread.join(10)
     red.close()
     assert seen[0] == ["blue-1"] and seen[-1] == []
+
+
+def test_an_online_team_run_is_recorded_and_replays_bit_for_bit(server, tmp_path):
+    from gymfg_il.recording.reader import read_log
+    from gymfg_il.recording.recorder import Recorder
+    from gymfg_il.recording.replay import replay_episode
+
+    address, _ = server("--mode", "fixed", "--teams", "2")
+    blue = client(address, "", "blue", 5, 3, tmp_path / "blue.npy")
+    env = Recorder(OnlineEnv(address, timeout_s=20), tmp_path / "red", source="online")
+    states, _ = run_team.fly(env, run_team.teams(3)["red"], 5)
+    env.close()
+    assert blue.wait(60) == 0
+    log = read_log(next((tmp_path / "red" / "logs").glob("*.mcap")))
+    assert log.session["online"] and [a.callsign for a in log.spec.aircraft_specs] == [
+        "red-1",
+        "red-2",
+    ]
+    (ep,) = log.complete_episodes
+    assert np.array_equal(ep.steps["red-1"].state, states[:, 0])
+    saw = ep.views("red")
+    assert len(saw) == 30 and saw[-1].callsigns == ["blue-1"] and saw[-1].values.shape == (1, 6)
+    blue_states = np.load(tmp_path / "blue.npy")
+    from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
+
+    assert np.array_equal(saw[-1].values[0], blue_states[-1, 0][indices(DEFAULT_OPPONENT_VIEW)])
+    assert replay_episode(log, ep).identical

@@ -21,14 +21,14 @@ def session(tmp_path_factory):
 def test_log_holds_every_step_with_its_session(session):
     log = read_log(session.log)
     assert log.finished and len(log.complete_episodes) == 2
-    meta = log.session
-    assert meta["aircraft"] == "c172p" and meta["agent_hz"] == 10 and meta["source"] == "autopilot"
-    assert "jsbsim" in meta["versions"] and meta["env"]["dynamic"] is True
+    meta, spec = log.session, log.spec
+    assert spec.aircraft == "c172p" and spec.agent_hz == 10 and meta["source"] == "autopilot"
+    assert "jsbsim" in meta["versions"] and spec.dynamic is True
     ep = log.complete_episodes[0]
     steps = ep.steps["ego"]
     assert len(steps) == 200 and steps.state.shape == (200, len(NAMES))
     assert ep.start["seed"] == 0 and ep.end["outcome"] == "time limit"
-    assert steps.observation.shape[1] == len(meta["observation_names"])
+    assert steps.observation.shape[1] == len(log.aircraft("ego")["observation_names"])
     # DART noise: executed actions differ from the clean labels, throttle untouched
     assert not np.array_equal(steps.action[:, :3], steps.label[:, :3])
     assert np.array_equal(steps.action[:, 3], steps.label[:, 3])
@@ -79,7 +79,7 @@ def test_unfinished_log_keeps_completed_episodes(session, tmp_path):
 
 def test_writer_never_overwrites_and_reader_rejects_garbage(tmp_path, session):
     with pytest.raises(FileExistsError):
-        TrajectoryWriter(session.log, {}, ["ego"], 0.1)
+        TrajectoryWriter(session.log, {})
     junk = tmp_path / "junk.mcap"
     junk.write_bytes(b"not an mcap file at all" * 10)
     with pytest.raises(LogError, match="not a readable GymFG trajectory log"):
