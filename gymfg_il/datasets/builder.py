@@ -1,28 +1,24 @@
 """Writing LeRobot v3.0 datasets whole episodes at a time.
 
-LeRobot's own ``LeRobotDatasetMetadata`` writes ``info.json``, the task table, the episode
-table and the statistics (``compute_episode_stats``); the episode's frames go to the data
-parquet as one Arrow table in LeRobot's schema (``get_hf_features_from_features``). LeRobot's
-per-frame path (``add_frame`` + ``save_episode``) spends most of its time in a per-row
-``datasets.map`` and a per-frame task lookup; writing columns directly is what lets a dataset
-be rebuilt from logs at tens of thousands of frames per second. Stock ``LeRobotDataset`` opens
-the result.
+LeRobot's own metadata (``LeRobotDatasetMetadata``, through ``datasets.lerobot_api``) writes
+``info.json``, the task table, the episode table and the statistics; the episode's frames go
+to the data parquet as one Arrow table in LeRobot's schema. LeRobot's per-frame path
+(``add_frame`` + ``save_episode``) spends most of its time in a per-row ``datasets.map`` and a
+per-frame task lookup; writing columns directly is what lets a dataset be rebuilt from logs at
+tens of thousands of frames per second. Stock ``LeRobotDataset`` opens the result, and the
+parity test checks it against LeRobot's own writer.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.features import check_compatible
 from gymfg_il.errors import ConfigError
-
-os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 
 class DatasetBuilder:
@@ -44,12 +40,10 @@ class DatasetBuilder:
         features: dict[str, dict[str, Any]],
         robot_type: str | None = None,
     ) -> None:
-        from lerobot.datasets.dataset_metadata import LeRobotDatasetMetadata
-
         root = Path(root)
         self.root = root
         if (root / "meta" / "info.json").is_file():
-            meta = LeRobotDatasetMetadata(repo_id, root=root)
+            meta = lr.open_metadata(root, repo_id)
             check_compatible(meta.features, features, str(root))
             if meta.fps != fps:
                 raise ConfigError(
@@ -64,9 +58,7 @@ class DatasetBuilder:
         else:
             if root.exists():
                 root.rmdir()
-            meta = LeRobotDatasetMetadata.create(
-                repo_id, fps, features, robot_type=robot_type, root=root, use_videos=False
-            )
+            meta = lr.create_metadata(root, repo_id, fps, features, robot_type)
         self.meta = meta
         self._writer: Any = None
         self._schema: Any = None
@@ -78,10 +70,8 @@ class DatasetBuilder:
             chunk, file = 0, 0
             episodes = self.meta.episodes
             if episodes is not None and len(episodes) > 0:
-                from lerobot.datasets.utils import update_chunk_file_indices
-
                 last = episodes[-1]
-                chunk, file = update_chunk_file_indices(
+                chunk, file = lr.next_data_file(
                     last["data/chunk_index"], last["data/file_index"], self.meta.chunks_size
                 )
             self._file = (chunk, file)
@@ -97,8 +87,6 @@ class DatasetBuilder:
         """Append one episode; ``columns`` maps each of our features to a (frames, ...) array."""
         import pyarrow as pa
         import pyarrow.parquet as pq
-        from lerobot.datasets.compute_stats import compute_episode_stats
-        from lerobot.datasets.feature_utils import get_hf_features_from_features
 
         meta = self.meta
         n = len(columns["action"])
@@ -106,25 +94,27 @@ class DatasetBuilder:
             raise ConfigError("an episode needs at least one frame")
         index = meta.total_episodes
         start = meta.total_frames
-        meta.save_episode_tasks([task])
         frames = {
             # shape-(1,) features are scalars per frame, as LeRobot stores them
             **{
                 k: np.asarray(v).reshape(n, *self._shape(k)).astype(meta.features[k]["dtype"])
                 for k, v in columns.items()
             },
-            "timestamp": (np.arange(n) / meta.fps).astype(np.float32),
+            # float64 as LeRobot's own writer computes its statistics; stored as float32
+            "timestamp": np.arange(n) / meta.fps,
             "frame_index": np.arange(n, dtype=np.int64),
             "episode_index": np.full(n, index, dtype=np.int64),
             "index": np.arange(start, start + n, dtype=np.int64),
-            "task_index": np.full(n, meta.get_task_index(task), dtype=np.int64),
+            "task_index": np.full(n, lr.task_index(meta, task), dtype=np.int64),
         }
-        stats = compute_episode_stats(frames, meta.features)
+        stats = lr.episode_stats(frames, meta.features)
         if self._schema is None:
-            self._schema = get_hf_features_from_features(meta.features).arrow_schema
+            self._schema = lr.arrow_schema(meta.features)
         arrays = []
         for field in self._schema:
             values = frames[field.name]
+            if field.name == "timestamp":
+                values = values.astype(np.float32)
             if values.ndim == 1:
                 arrays.append(pa.array(values, type=field.type))
             else:
@@ -144,33 +134,13 @@ class DatasetBuilder:
             "dataset_to_index": start + n,
             **{f"gymfg/{k}": v for k, v in (metadata or {}).items()},
         }
-        with _deferred_info_and_stats():
-            meta.save_episode(index, n, [task], stats, episode_meta)
+        lr.save_episode(meta, index, n, task, stats, episode_meta)
         return index
 
     def finalize(self) -> None:
-        """Close the data file, flush LeRobot's buffered episode table, and write
-        ``info.json`` and ``stats.json`` (mandatory: before it the dataset is incomplete)."""
-        from lerobot.datasets.io_utils import write_info, write_stats
-
+        """Close the data file and flush LeRobot's buffered episode table (mandatory: before
+        it the dataset is incomplete)."""
         if self._writer is not None:
             self._writer.close()
             self._writer = None
         self.meta.finalize()
-        write_info(self.meta.info, self.root)
-        if self.meta.stats is not None:
-            write_stats(self.meta.stats, self.root)
-
-
-@contextlib.contextmanager
-def _deferred_info_and_stats() -> Iterator[None]:
-    """LeRobot rewrites info.json and stats.json after every episode; a build writes them
-    once, in ``finalize`` (the whole build is swapped in only when complete anyway)."""
-    import lerobot.datasets.dataset_metadata as dm
-
-    saved = dm.write_info, dm.write_stats
-    dm.write_info = dm.write_stats = lambda *args, **kwargs: None
-    try:
-        yield
-    finally:
-        dm.write_info, dm.write_stats = saved

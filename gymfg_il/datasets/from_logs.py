@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.features import dataset_features
 from gymfg_il.errors import ConfigError
@@ -51,50 +52,80 @@ def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarr
     }
 
 
-def episode_metadata(
-    log_file: Path, episode: LoggedEpisode, session: dict[str, Any], callsign: str
-) -> dict[str, Any]:
+def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[str, Any]:
+    """The ``gymfg/*`` columns of one aircraft's episode: where it comes from and what was
+    flown (``spec``: the flight spec, JSON)."""
     start, end = episode.start, episode.end or {}
-    target = start.get("target")
+    target = episode.start_of(callsign).get("target")
+    info = log.aircraft(callsign)
+    task = info.get("task", {}).get("task", "")
     return {
-        "aircraft": str(session.get("aircraft", "")),
+        "aircraft": str(info.get("model", "")),
         "callsign": callsign,
-        "task": str(session.get("task", "")),
+        "team": str(info.get("team", "")),
+        "task": str(task),
         "target": float(target) if target is not None else math.nan,
         "seed": int(start.get("seed", -1)),
-        "source": str(start.get("source", session.get("source", ""))),
+        "source": str(start.get("source", log.session.get("source", ""))),
         "interventions": int(episode.steps[callsign].intervention.sum()),
         "iteration": int(start.get("iteration", 0)),
         "outcome": str(end.get("outcome", "")),
-        "log": log_file.name,
+        "log": log.path.name,
         "log_episode": int(episode.index),
+        "spec": log.spec.to_json(),
     }
 
 
 def _dataset_ok(root: Path) -> bool:
-    from lerobot.datasets.dataset_metadata import LeRobotDatasetMetadata
-
     try:
-        meta = LeRobotDatasetMetadata("gymfg/check", root=root)
+        meta = lr.open_metadata(root)
         return meta.episodes is None or len(meta.episodes) == meta.total_episodes
     except Exception:  # any failure to load means: rebuild from the logs
         return False
 
 
 def _present(root: Path) -> set[tuple[str, int, str]]:
-    from lerobot.datasets.dataset_metadata import LeRobotDatasetMetadata
-
-    meta = LeRobotDatasetMetadata("gymfg/check", root=root)
+    meta = lr.open_metadata(root)
     if meta.episodes is None or "gymfg/log" not in meta.episodes.column_names:
         return set()
     eps = meta.episodes
     return set(zip(eps["gymfg/log"], eps["gymfg/log_episode"], eps["gymfg/callsign"], strict=True))
 
 
+def _chosen(logs: list[Log], callsigns: Sequence[str] | None) -> list[tuple[Log, str]]:
+    """(log, callsign) of every aircraft to take, checked to share one layout and rate."""
+    chosen = [
+        (lg, c) for lg in logs for c in lg.session.get("callsigns", [])
+        if callsigns is None or c in callsigns
+    ]  # fmt: skip
+    if not chosen:
+        raise ConfigError(f"the logs hold no aircraft {list(callsigns or [])}")
+    first_log, first = chosen[0]
+    names = first_log.aircraft(first)["observation_names"]
+    fps = first_log.spec.agent_hz
+    for lg, c in chosen[1:]:
+        if lg.aircraft(c)["observation_names"] != names:
+            raise ConfigError(
+                f"{c!r} in {lg.path.name} observes other variables than {first!r} in "
+                f"{first_log.path.name}; one dataset holds one observation layout: build one "
+                "per task (choose the aircraft with callsigns=, `collect recover --callsign`)"
+            )
+        if lg.spec.agent_hz != fps:
+            raise ConfigError(
+                f"{lg.path.name} records another rate ({lg.spec.agent_hz} Hz) than "
+                f"{first_log.path.name} ({fps} Hz); one dataset holds one fps"
+            )
+    return chosen
+
+
 def build_from_logs(
-    log_paths: Sequence[Path], root: Path, repo_id: str | None = None
+    log_paths: Sequence[Path],
+    root: Path,
+    repo_id: str | None = None,
+    callsigns: Sequence[str] | None = None,
 ) -> BuildReport:
-    """Make the dataset at ``root`` hold every completed episode of ``log_paths``.
+    """Make the dataset at ``root`` hold every completed episode of ``log_paths``: one
+    dataset episode per aircraft and logged episode (``callsigns``: only these aircraft).
 
     Episodes already in the dataset (by log file, episode and callsign) are kept; a dataset
     that cannot be read is set aside as ``<root>.broken-<time>`` and rebuilt from the logs.
@@ -103,30 +134,28 @@ def build_from_logs(
     enabled = gc.isenabled()
     gc.disable()
     try:
-        return _build(log_paths, Path(root), repo_id)
+        return _build(log_paths, Path(root), repo_id, callsigns)
     finally:
         if enabled:
             gc.enable()
 
 
-def _build(log_paths: Sequence[Path], root: Path, repo_id: str | None) -> BuildReport:
-    import lerobot.datasets.dataset_metadata  # noqa: F401  (its import is not build time)
-
+def _build(
+    log_paths: Sequence[Path], root: Path, repo_id: str | None, callsigns: Sequence[str] | None
+) -> BuildReport:
+    lr.load()  # LeRobot's import is not build time
     started = time.perf_counter()
     logs: list[Log] = [read_log(p) for p in sorted(log_paths)]
     if not logs:
         raise ConfigError(f"no trajectory logs to build {root} from")
-    first = logs[0].session
-    names = first["observation_names"]
-    for lg in logs[1:]:
-        if lg.session["observation_names"] != names or lg.session["agent_hz"] != first["agent_hz"]:
-            raise ConfigError(
-                f"{lg.path.name} records another task or rate than {logs[0].path.name}; one "
-                "dataset holds one observation layout and one fps"
-            )
-    features = dataset_features(names)
-    fps = int(first["agent_hz"])
-    repo_id = repo_id or f"gymfg/{first['task']}-{first['aircraft']}"
+    chosen = _chosen(logs, callsigns)
+    first_log, first = chosen[0]
+    info = first_log.aircraft(first)
+    features = dataset_features(info["observation_names"])
+    fps = first_log.spec.agent_hz
+    label = info["task"].get("task", "task")
+    repo_id = repo_id or f"gymfg/{label}-{info['model']}"
+    taken = {(lg.path, c) for lg, c in chosen}
     rebuilt = False
     work = root.with_name(f"{root.name}.building-{time.time_ns()}")
     if root.exists() and _dataset_ok(root):
@@ -145,18 +174,20 @@ def _build(log_paths: Sequence[Path], root: Path, repo_id: str | None) -> BuildR
         present = set()
     added = frames = skipped = 0
     try:
-        builder = DatasetBuilder(work, repo_id, fps, features, robot_type=first["aircraft"])
+        builder = DatasetBuilder(work, repo_id, fps, features, robot_type=info["model"])
         for lg in logs:
             skipped += sum(1 for e in lg.episodes if not e.complete and not e.discarded)
             for episode in lg.complete_episodes:
-                for callsign in sorted(episode.steps):
+                for callsign in episode.steps:  # in the order the flight lists them
+                    if (lg.path, callsign) not in taken:
+                        continue
                     if (lg.path.name, episode.index, callsign) in present:
                         continue
                     columns = episode_columns(episode, callsign)
                     builder.add_episode(
                         columns,
-                        lg.session["task_description"],
-                        episode_metadata(lg.path, episode, lg.session, callsign),
+                        lg.aircraft(callsign)["task_description"],
+                        episode_metadata(lg, episode, callsign),
                     )
                     added += 1
                     frames += len(columns["action"])

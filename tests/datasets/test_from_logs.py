@@ -41,7 +41,7 @@ def test_dataset_opens_with_stock_lerobot_and_equals_the_log(built):
     ds = LeRobotDataset("anything/name", root=out / "dataset")
     assert ds.num_episodes == 3 and len(ds) == 450 and ds.fps == 10
     log = read_log(result.log)
-    names = log.session["observation_names"]
+    names = log.aircraft("ego")["observation_names"]
     assert ds.meta.features["observation.state"]["names"] == names
     assert ds.meta.features["action"]["names"] == ["aileron", "elevator", "rudder", "throttle"]
     for k, ep in enumerate(log.complete_episodes):
@@ -59,7 +59,7 @@ def test_dataset_opens_with_stock_lerobot_and_equals_the_log(built):
         meta = ds.meta.episodes[k]
         assert meta["gymfg/seed"] == k and meta["gymfg/source"] == "autopilot"
         assert meta["gymfg/aircraft"] == "c172p" and meta["gymfg/interventions"] == 0
-        assert meta["gymfg/target"] == pytest.approx(ep.start["target"])
+        assert meta["gymfg/target"] == pytest.approx(ep.start_of("ego")["target"])
 
 
 def test_rebuilding_adds_nothing_twice_and_keeps_data(built):

@@ -1,0 +1,145 @@
+"""The one boundary to LeRobot: every LeRobot import of the project happens here.
+
+What the project needs of LeRobot 0.6 is small: its dataset metadata (``info.json``, tasks,
+the episode table, statistics), its Arrow schema of features, its per-episode statistics, and
+its ``LeRobotDataset`` to read a dataset. Each is reached here with keyword arguments, after
+checking that the installed LeRobot is one this module was written against (``SUPPORTED``):
+an upgrade that moves these names fails here with a clear error, and the parity test
+(``tests/datasets/test_lerobot_parity.py``) tells whether the format itself changed.
+
+The Hugging Face Hub is never needed: datasets are local. Entry points call ``hub_offline()``
+before anything imports LeRobot, so a missing local file is an error and not a download.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from pathlib import Path
+from typing import Any
+
+from gymfg_il.errors import ConfigError
+
+SUPPORTED = ((0, 6), (0, 7))  # [0.6, 0.7)
+SUPPORTED_TEXT = ">=0.6,<0.7"
+
+
+def hub_offline() -> None:
+    """Keep LeRobot (and ``huggingface_hub``) off the network; call before importing them."""
+    os.environ["HF_HUB_OFFLINE"] = "1"
+
+
+@functools.cache
+def check_version() -> str:
+    """The installed LeRobot's version; a clear error when it is not a supported one."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        found = version("lerobot")
+    except PackageNotFoundError:
+        raise ConfigError(
+            f"LeRobot is not installed; GymFG-IL needs lerobot[dataset]{SUPPORTED_TEXT} "
+            "(pip install -e .)"
+        ) from None
+    parts = tuple(int(p) for p in found.split(".")[:2] if p.isdigit())
+    if not SUPPORTED[0] <= parts < SUPPORTED[1]:
+        raise ConfigError(
+            f"LeRobot {found} is installed, but GymFG-IL writes and reads datasets through "
+            f"LeRobot {SUPPORTED_TEXT}; install that range (pip install 'lerobot[dataset]"
+            f"{SUPPORTED_TEXT}')"
+        )
+    return found
+
+
+def load() -> None:
+    """Import the LeRobot modules used here (seconds, once per process), so that what is
+    timed afterwards is the work, not the import."""
+    check_version()
+    import lerobot.datasets.compute_stats
+    import lerobot.datasets.dataset_metadata
+    import lerobot.datasets.feature_utils
+    import lerobot.datasets.lerobot_dataset  # noqa: F401
+
+
+def open_metadata(root: Path, repo_id: str = "gymfg/local") -> Any:
+    """The ``LeRobotDatasetMetadata`` of the dataset at ``root``."""
+    check_version()
+    from lerobot.datasets.dataset_metadata import LeRobotDatasetMetadata
+
+    return LeRobotDatasetMetadata(repo_id=repo_id, root=Path(root))
+
+
+def create_metadata(
+    root: Path, repo_id: str, fps: int, features: dict[str, Any], robot_type: str | None
+) -> Any:
+    """New dataset metadata at ``root`` (which must not exist), no videos."""
+    check_version()
+    from lerobot.datasets.dataset_metadata import LeRobotDatasetMetadata
+
+    return LeRobotDatasetMetadata.create(
+        repo_id=repo_id,
+        fps=fps,
+        features=features,
+        robot_type=robot_type,
+        root=Path(root),
+        use_videos=False,
+    )
+
+
+def open_dataset(root: Path, repo_id: str = "gymfg/local") -> Any:
+    """Stock ``LeRobotDataset`` over the dataset at ``root`` (decoding with PyAV)."""
+    check_version()
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    return LeRobotDataset(repo_id=repo_id, root=Path(root), video_backend="pyav")
+
+
+def arrow_schema(features: dict[str, Any]) -> Any:
+    """The Arrow schema LeRobot stores the frames of ``features`` in."""
+    check_version()
+    from lerobot.datasets.feature_utils import get_hf_features_from_features
+
+    return get_hf_features_from_features(features=features).arrow_schema
+
+
+def episode_stats(frames: dict[str, Any], features: dict[str, Any]) -> dict[str, Any]:
+    """LeRobot's statistics of one episode's frames."""
+    check_version()
+    from lerobot.datasets.compute_stats import compute_episode_stats
+
+    stats: dict[str, Any] = compute_episode_stats(episode_data=frames, features=features)
+    return stats
+
+
+def next_data_file(chunk: int, file: int, chunks_size: int) -> tuple[int, int]:
+    """The (chunk, file) after ``(chunk, file)`` in LeRobot's data layout."""
+    check_version()
+    from lerobot.datasets.utils import update_chunk_file_indices
+
+    found = update_chunk_file_indices(chunk_idx=chunk, file_idx=file, chunks_size=chunks_size)
+    return int(found[0]), int(found[1])
+
+
+def task_index(meta: Any, task: str) -> int:
+    """The index of ``task`` in the dataset's task table (added when new)."""
+    meta.save_episode_tasks(tasks=[task])
+    return int(meta.get_task_index(task=task))
+
+
+def save_episode(
+    meta: Any,
+    index: int,
+    length: int,
+    task: str,
+    stats: dict[str, Any],
+    metadata: dict[str, Any],
+) -> None:
+    """Register one episode (its table row and statistics) with LeRobot's metadata, which
+    rewrites ``info.json`` and ``stats.json``."""
+    meta.save_episode(
+        episode_index=index,
+        episode_length=length,
+        episode_tasks=[task],
+        episode_stats=stats,
+        episode_metadata=metadata,
+    )
