@@ -76,3 +76,37 @@ def test_help_explains_every_option():
     ):
         assert option in out
     assert "Figure 1" in out
+
+
+def test_a_policy_flies_at_its_own_rate_and_the_rows_say_so(tmp_path, capsys):
+    from gymfg_il.collectors.autopilot import collect_autopilot
+    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.evaluation.config import EvalConfig, run_eval
+    from gymfg_il.learning.bc import TrainConfig, train_bc
+
+    demo = CollectConfig(
+        task="roll", episodes=3, episode_time_s=4, agent_hz=30, seed=1000, out=tmp_path / "demo"
+    )
+    collect_autopilot(demo)
+    policy = train_bc(
+        TrainConfig(dataset=tmp_path / "demo" / "dataset", out=tmp_path / "p", epochs=2)
+    ).out
+    assert json.loads((policy / "config.json").read_text())["spec"]["agent_hz"] == 30
+    rows_json = tmp_path / "rows.json"
+    args = ["--policy", str(policy), "--episodes", "2", "--no-progress"]
+    assert evaluate.main([*args, "--json", str(rows_json)]) == 0
+    assert "roll on c172p at 30 Hz" in capsys.readouterr().out
+    rows = json.loads(rows_json.read_text())["rows"]
+    assert [r["agent"] for r in rows] == ["controller", "policy:p"]
+    for row in rows:
+        assert (row["agent_hz"], row["task"], row["aircraft"]) == (30, "roll", "c172p")
+        assert row["spec"] == demo.flight().to_dict() and row["episode_time_s"] == 4
+    run = run_eval(EvalConfig(policy=[policy], episodes=1))
+    assert all(len(t[0].rewards) == 4 * 30 for t in run.traces.values())  # 30 steps a second
+    # another rate is refused: the policy learnt its actions at 30 Hz
+    assert evaluate.main([*args, "--agent-hz", "10"]) == 2
+    assert "trained at 30 Hz" in capsys.readouterr().err
+    # another aircraft is what the user asked for: flown, and said so
+    assert evaluate.main([*args, "--aircraft", "f15", "--json", str(rows_json)]) == 0
+    assert "aircraft='f15'" in capsys.readouterr().err
+    assert {r["aircraft"] for r in json.loads(rows_json.read_text())["rows"]} == {"f15"}

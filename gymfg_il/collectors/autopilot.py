@@ -7,15 +7,9 @@ from collections.abc import Callable
 
 from gymfg_il.collectors.config import CollectConfig
 from gymfg_il.collectors.session import DATASET, LOGS, SessionResult, record_session
-from gymfg_il.parallel import AgentSpec, EnvSpec, Workers
-
-__all__ = ["DATASET", "LOGS", "env_spec", "record_autopilot"]
-
-
-def env_spec(cfg: CollectConfig) -> EnvSpec:
-    return EnvSpec(
-        cfg.task, cfg.aircraft, cfg.dynamic, cfg.agent_hz, cfg.episode_time_s, dict(cfg.task_kwargs)
-    )
+from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
+from gymfg_il.rollout.agents import AgentSpec
+from gymfg_il.workers import Workers
 
 
 def record_autopilot(
@@ -26,7 +20,7 @@ def record_autopilot(
     """Fly ``cfg.episodes`` controller episodes and log them (the dataset is built after)."""
     seeds = range(cfg.seed, cfg.seed + cfg.episodes)
     return record_session(
-        env_spec(cfg),
+        cfg.flight(),
         AgentSpec.controller(),
         None,
         seeds,
@@ -36,3 +30,20 @@ def record_autopilot(
         workers=workers,
         progress=progress,
     )
+
+
+def collect_autopilot(
+    cfg: CollectConfig,
+    workers: int = 1,
+    progress: Callable[[int], Callable[[int, float], None]] | None = None,
+) -> tuple[SessionResult, BuildReport]:
+    """Record ``cfg``'s episodes on ``workers`` processes, then bring ``cfg.out/dataset`` up
+    to date with every log of the session folder.
+
+    ``progress(total)`` is called once the workers run (a bar made before would start a
+    thread, and the workers could then not be forked) and returns the per-episode callback."""
+    with Workers(min(workers, cfg.episodes)) as pool:
+        tick = progress(cfg.episodes) if progress else None
+        result = record_autopilot(cfg, workers=pool, progress=tick)
+    report = build_from_logs(sorted((cfg.out / LOGS).glob("*.mcap")), cfg.out / DATASET)
+    return result, report

@@ -2,11 +2,47 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-    from gymfg_il.datasets.from_logs import BuildReport
+from gymfg_il.collectors.session import DATASET, LOGS
+from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
+from gymfg_il.errors import ConfigError
+from gymfg_il.recording.reader import read_log
+from gymfg_il.recording.replay import replay_episode, world_for
+
+
+@dataclass
+class RecoverConfig:
+    """Rebuild a session's dataset from its logs (after a crash or kill: keeps every
+    completed episode).
+
+    Attributes:
+        dir: the session folder (logs/ inside).
+        callsign: only this aircraft's episodes (repeatable; default: every aircraft, all of
+            one observation layout).
+    """
+
+    dir: Path = field(metadata={"positional": True})
+    callsign: list[str] = field(default_factory=list, metadata={"repeat": True})
+
+
+@dataclass
+class ReplayConfig:
+    """Re-fly logged episodes through JSBSim from their seeds and actions, and check every
+    state of every aircraft matches the log bit for bit.
+
+    Attributes:
+        log: an .mcap log, or a session folder (all its logs).
+        episode: only this episode (default: all completed).
+        view: also show the replay in FlightGear listening on this UDP port (repeatable;
+            real time; see gymfg_il.viz.flightgear).
+    """
+
+    log: Path = field(metadata={"positional": True})
+    episode: int | None = None
+    view: list[int] = field(default_factory=list, metadata={"repeat": True})
 
 
 def report_build(report: BuildReport, root: Path) -> None:
@@ -23,12 +59,8 @@ def report_build(report: BuildReport, root: Path) -> None:
         )
 
 
-def replay(target: Path, episode: int | None, views: list[int] | None = None) -> int:
-    from gymfg_il.collectors.autopilot import LOGS
-    from gymfg_il.errors import ConfigError
-    from gymfg_il.recording.reader import read_log
-    from gymfg_il.recording.replay import env_from_session, replay_episode
-
+def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
+    """Re-fly every completed episode of the log(s) at ``target``; 1 if any differs."""
     paths = sorted((target / LOGS).glob("*.mcap")) if target.is_dir() else [target]
     if not paths:
         raise ConfigError(f"no logs under {target}")
@@ -39,32 +71,31 @@ def replay(target: Path, episode: int | None, views: list[int] | None = None) ->
         if episode is not None and not chosen:
             raise ConfigError(f"{path.name} has no completed episode {episode}")
         for ep in chosen:
-            for callsign in sorted(ep.steps):
-                env = env_from_session(log.session, views) if views else None
-                r = replay_episode(log, ep, callsign, env=env)
-                if env is not None:
-                    env.close()
-                verdict = (
-                    "identical"
-                    if r.identical
-                    else (f"DIFFERS from step {r.first_mismatch} (max |diff| {r.max_abs_diff:.3g})")
-                )
-                print(f"{path.name} episode {ep.index} {callsign}: {r.steps} steps, {verdict}")
-                failures += not r.identical
+            world = world_for(log, views) if views else None
+            try:
+                r = replay_episode(log, ep, world=world)
+            finally:
+                if world is not None:
+                    world.close()
+                    world.pool.close()
+            for callsign, (same, first) in r.per_aircraft.items():
+                steps = len(ep.steps[callsign])
+                verdict = "identical" if same else f"DIFFERS from step {first}"
+                print(f"{path.name} episode {ep.index} {callsign}: {steps} steps, {verdict}")
+            if not r.identical:
+                print(f"  largest |difference| {r.max_abs_diff:.3g}")
+            failures += not r.identical
     return 1 if failures else 0
 
 
-def recover(folder: Path) -> int:
-    from gymfg_il.collectors.autopilot import DATASET, LOGS
-    from gymfg_il.datasets.from_logs import build_from_logs
-    from gymfg_il.errors import ConfigError
-
+def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
+    """Rebuild ``folder/dataset`` from ``folder/logs`` (``callsigns``: only these aircraft)."""
     logs = sorted((folder / LOGS).glob("*.mcap")) if folder.is_dir() else []
     if not logs:
         raise ConfigError(
             f"{folder} holds no {LOGS}/*.mcap: nothing to recover from (is it a "
             "collection session folder?)"
         )
-    report = build_from_logs(logs, folder / DATASET)
+    report = build_from_logs(logs, folder / DATASET, callsigns=callsigns or None)
     report_build(report, folder / DATASET)
     return 0

@@ -10,11 +10,11 @@ import math
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, join_problems
-from gymfg_il.sim.timing import substeps
-from gymfg_il.tasks.library import task_class
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ
 
 
 @dataclass
@@ -23,12 +23,12 @@ class CollectConfig:
 
     Attributes:
         kind: who flies: ``autopilot`` (the task's PID controller) or ``manual`` (a person).
-        aircraft: JSBSim model.
-        task: task family (altitude, roll, pitch, heading, airspeed, level).
-        dynamic: moving targets.
-        episodes: episodes to record.
+        aircraft: JSBSim model (c172p, f15, A320, or any other JSBSim ships).
+        task: task family: altitude, roll, pitch, heading, airspeed, level.
+        dynamic: moving targets instead of fixed ones.
+        episodes: episodes to record (manual: 0 = until you quit).
         episode_time_s: seconds per episode.
-        agent_hz: agent rate = dataset fps; divides 120.
+        agent_hz: agent rate = the dataset's fps, a divisor of 120.
         seed: seed of the first episode (episode i uses seed + i).
         noise: DART-style noise: std of Gaussian noise added to the executed surfaces (the
             dataset keeps the demonstrator's clean action as the label); 0 = none.
@@ -37,24 +37,27 @@ class CollectConfig:
         device: manual only: keyboard, mouse or joystick.
         assist: manual only: ``controller`` or a policy folder that flies until the person
             takes over (T); the person's frames are flagged as interventions.
+        view: manual only: UDP ports of FlightGear out-the-window views (repeatable; see
+            gymfg_il.viz.flightgear).
         keyboard: manual only: key bindings (see ``manual.bindings.KeyboardBindings``).
         mouse: manual only: mouse bindings (``MouseBindings``).
         joystick: manual only: joystick axes, dead zones, expo, buttons (``JoystickBindings``).
     """
 
-    kind: str = "autopilot"
+    kind: Literal["autopilot", "manual"] = "autopilot"
     aircraft: str = "c172p"
     task: str = "altitude"
     dynamic: bool = False
     episodes: int = 10
-    episode_time_s: float = 90.0
-    agent_hz: int = 10
+    episode_time_s: float = field(default=90.0, metadata={"flag": "--episode-time"})
+    agent_hz: int = DEFAULT_AGENT_HZ
     seed: int = 0
     noise: float = 0.0
     out: Path = Path("datasets/autopilot")
     task_kwargs: dict[str, Any] = field(default_factory=dict)
-    device: str = "keyboard"
+    device: Literal["keyboard", "mouse", "joystick"] = "keyboard"
     assist: str | None = None
+    view: list[int] = field(default_factory=list, metadata={"repeat": True})
     keyboard: dict[str, Any] = field(default_factory=dict)
     mouse: dict[str, Any] = field(default_factory=dict)
     joystick: dict[str, Any] = field(default_factory=dict)
@@ -68,25 +71,33 @@ class CollectConfig:
             problems.append(f"device={self.device!r}: choose keyboard, mouse or joystick")
         if self.task in ("dummy",):
             problems.append("task 'dummy' has no controller to demonstrate it")
+        elif not (isinstance(self.episode_time_s, (int, float)) and self.episode_time_s > 0):
+            problems.append(f"episode_time_s={self.episode_time_s!r} must be > 0")
         else:
             try:
-                task_class(self.task, self.dynamic)
+                self.flight()
             except ConfigError as err:
                 problems.append(str(err))
-        if not isinstance(self.episodes, int) or self.episodes < 1:
-            problems.append(f"episodes={self.episodes!r} must be an integer >= 1")
-        if not (isinstance(self.episode_time_s, (int, float)) and self.episode_time_s > 0):
-            problems.append(f"episode_time_s={self.episode_time_s!r} must be > 0")
-        try:
-            substeps(120, self.agent_hz)
-        except ConfigError as err:
-            problems.append(str(err))
+        least = 0 if self.kind == "manual" else 1  # a person may fly until they quit
+        if not isinstance(self.episodes, int) or self.episodes < least:
+            problems.append(f"episodes={self.episodes!r} must be an integer >= {least}")
         if not (
             isinstance(self.noise, (int, float)) and math.isfinite(self.noise) and self.noise >= 0
         ):
             problems.append(f"noise={self.noise!r} must be a number >= 0")
         if problems:
             raise ConfigError(join_problems("collection config", problems))
+
+    def flight(self) -> FlightSpec:
+        """What the session flies."""
+        return FlightSpec.solo(
+            self.aircraft,
+            self.task,
+            dynamic=self.dynamic,
+            task_kwargs=self.task_kwargs,
+            agent_hz=self.agent_hz,
+            episode_time_s=self.episode_time_s,
+        )
 
     @classmethod
     def from_recipe(cls, path: Path, **overrides: Any) -> CollectConfig:

@@ -19,13 +19,9 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.collectors.session import (
-    DATASET,
-    check_appendable,
-    check_out_folder,
-    new_log_path,
-    session_record,
-)
+from gymfg_il.collectors.session import DATASET, check_appendable, check_out_folder
+from gymfg_il.collectors.updater import DatasetUpdater
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.manual.bindings import (
     JoystickBindings,
     KeyboardBindings,
@@ -34,9 +30,12 @@ from gymfg_il.manual.bindings import (
 )
 from gymfg_il.manual.controller import ManualController
 from gymfg_il.manual.gui import ControlsGUI, GuiFrame
-from gymfg_il.manual.updater import DatasetUpdater
-from gymfg_il.parallel import AgentSpec, EnvSpec
+from gymfg_il.manual.takeover import Takeover
+from gymfg_il.recording.recorder import new_log_path
+from gymfg_il.recording.session import session_record
 from gymfg_il.recording.writer import TrajectoryWriter
+from gymfg_il.rollout.agents import AgentSpec
+from gymfg_il.rollout.loop import Rollout
 from gymfg_il.sim.properties import BY_NAME, INDEX
 
 log = logging.getLogger(__name__)
@@ -103,7 +102,7 @@ class ManualSession:
     """Run the collection loop.
 
     Args:
-        env_spec: what to fly.
+        flight: what to fly (a solo flight spec).
         out: session folder (``logs/``, ``dataset/``).
         device: keyboard, mouse or joystick.
         bindings: recipe tables ``{"keyboard": {...}, "mouse": {...}, "joystick": {...}}``.
@@ -113,11 +112,12 @@ class ManualSession:
         max_episodes: stop after this many saved episodes (0 = until quit).
         realtime: pace frames to the wall clock at the env's rate.
         on_frame: called at the start of each frame (tests inject events with it).
+        views: FlightGear UDP ports showing the aircraft (out-the-window views).
     """
 
     def __init__(
         self,
-        env_spec: EnvSpec,
+        flight: FlightSpec,
         out: Path,
         device: str = "keyboard",
         bindings: dict[str, dict[str, Any]] | None = None,
@@ -126,14 +126,15 @@ class ManualSession:
         max_episodes: int = 0,
         realtime: bool = True,
         on_frame: Callable[[int, ManualSession], None] | None = None,
+        views: tuple[int, ...] = (),
     ) -> None:
         bindings = bindings or {}
         out = Path(out)
         check_out_folder(out)
-        self.spec, self.out, self.seed, self.max_episodes = env_spec, out, seed, max_episodes
+        self.flight, self.out, self.seed, self.max_episodes = flight, out, seed, max_episodes
         self.realtime, self.on_frame = realtime, on_frame
-        self.env = env_spec.make()
-        check_appendable(out, self.env.observation_names, env_spec.agent_hz)
+        self.env = flight.make_env(list(views) or None)
+        check_appendable(out, self.env.observation_names, flight.agent_hz)
         self.kb = from_table(KeyboardBindings, bindings.get("keyboard"), "[collector.keyboard]")
         self.human = ManualController(
             device,
@@ -145,19 +146,21 @@ class ManualSession:
         self.assist_name = (
             None if assist is None else ("controller" if assist == "controller" else "policy")
         )
-        self.assistant = None
+        assistant = None
         if assist is not None:
             spec = (
                 AgentSpec.controller() if assist == "controller" else AgentSpec.policy(Path(assist))
             )
-            self.assistant = spec.make(self.env)
+            assistant = spec.make(self.env)
+        self.pilot = Takeover(self.human, assistant)
+        self.rollout = Rollout(self.env, [self.pilot])
         self.source = "human" if assist is None else f"{self.assist_name}+human"
         self.help = help_lines(device, self.kb)
-        self.gui = ControlsGUI(title=f"GymFG-IL: {env_spec.task} on {self.env.aircraft.model}")
+        title = f"GymFG-IL: {flight.task_label} on {self.env.aircraft.model}"
+        self.gui = ControlsGUI(title=title)
         self.human.window_size = self.gui.size
         self.stats = SessionStats()
         self.state = "idle"
-        self.human_flies = assist is None
         self.show_help = True
         self.episode = 0
         self.next_seed = seed  # a discarded episode is flown again with its seed
@@ -166,32 +169,22 @@ class ManualSession:
         self.writer: TrajectoryWriter | None = None
         self.updater = DatasetUpdater(out)
 
+    @property
+    def human_flies(self) -> bool:
+        return self.pilot.human_flies
+
     # -- episodes --------------------------------------------------------------------------
     def _writer(self) -> TrajectoryWriter:
         if self.writer is None:
-            record = session_record(self.spec, self.source, 0.0, device=self.human.device)
-            self.writer = TrajectoryWriter(
-                new_log_path(self.out, "manual"), record, ["ego"], self.env.dt
-            )
+            record = session_record(self.flight, self.source, device=self.human.device)
+            self.writer = TrajectoryWriter(new_log_path(self.out, "manual"), record)
         return self.writer
 
     def _start(self) -> None:
         seed = self.next_seed
-        self.obs, info = self.env.reset(seed=seed)
-        self.human.reset(seed)
-        if self.assistant is not None:
-            self.assistant.reset(seed)
+        starts = self.rollout.reset(seed)
         self.step_count, self.interventions = 0, 0
-        slot = self.env.world.slots[0]
-        self._writer().start_episode(
-            seed=seed,
-            task=self.env.task.describe(),
-            target=info["target"],
-            initial_state=dict(
-                zip(("lat_deg", "lon_deg", "altitude_ft"), slot.state[:3].tolist(), strict=True)
-            ),
-            source=self.source,
-        )
+        self._writer().start_episode(seed, starts, source=self.source)
         self.state, self.message, self.show_help = "recording", "", False
 
     def _finish(self, outcome: str) -> None:
@@ -226,40 +219,19 @@ class ManualSession:
             self._discard()
         elif command == "pause" and self.state in ("recording", "paused"):
             self.state = "paused" if self.state == "recording" else "recording"
-        elif command == "takeover" and self.assistant is not None:
-            self.human_flies = not self.human_flies
-            if self.human_flies:  # start from where the assistant had the controls
-                self.human.values[:] = self.last_action
+        elif command == "takeover":
+            self.pilot.toggle(self.last_action)
         return True
 
     def _step(self) -> None:
-        obs = self.obs
-        if self.human_flies:
-            action = self.human.act(obs)
-            if self.assistant is not None and hasattr(self.assistant, "track"):
-                self.assistant.act(obs)
-                self.assistant.track(action)  # bumpless hand-back
-        else:
-            action = np.clip(self.assistant.act(obs), [-1, -1, -1, 0], 1)  # type: ignore[union-attr]
-        self.last_action = action
-        self.obs, reward, terminated, truncated, info = self.env.step(action)
+        tick = self.rollout.step()
+        self._writer().log_tick(tick)
+        (step,) = tick.steps
+        self.last_action = step.action
         self.step_count += 1
-        intervention = self.assistant is not None and self.human_flies
-        self.interventions += int(intervention)
-        self._writer().log_step(
-            "ego",
-            self.step_count,
-            self.env.world.slots[0].state,
-            obs,
-            action,
-            action,
-            reward,
-            terminated,
-            truncated,
-            intervention,
-        )
-        if terminated or truncated:
-            self._finish(info.get("reason", "terminated") if terminated else "time limit")
+        self.interventions += int(step.intervention)
+        if tick.done:
+            self._finish(step.reason or "terminated" if step.terminated else "time limit")
 
     def _draw(self) -> None:
         env = self.env

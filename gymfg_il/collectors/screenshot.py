@@ -1,4 +1,4 @@
-"""``python -m gymfg_il.manual.screenshot PATH``: a PNG of the controls GUI in flight.
+"""``python -m gymfg_il.collectors.screenshot PATH``: a PNG of the controls GUI in flight.
 
 Runs the manual session off-screen (``SDL_VIDEODRIVER=dummy``) with the controller assisting,
 injects a stick input, and saves the window after a few seconds; the README's picture is made
@@ -22,8 +22,8 @@ def main(argv: list[str] | None = None) -> int:
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     import pygame
 
-    from gymfg_il.manual.session import ManualSession
-    from gymfg_il.parallel import EnvSpec
+    from gymfg_il.collectors.manual import ManualSession
+    from gymfg_il.envs.flight import FlightSpec
 
     def key(k: int, down: bool = True) -> None:
         kind = pygame.KEYDOWN if down else pygame.KEYUP
@@ -43,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
             key(pygame.K_q)
 
     with tempfile.TemporaryDirectory() as tmp:
-        spec = EnvSpec("altitude", "c172p", episode_time_s=30, agent_hz=30)
+        spec = FlightSpec.solo("c172p", "altitude", episode_time_s=30, agent_hz=30)
         ManualSession(
             spec, Path(tmp), assist="controller", realtime=False, seed=3, on_frame=on_frame
         ).run(max_frames=200)

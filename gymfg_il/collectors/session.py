@@ -1,4 +1,4 @@
-"""Recording sessions: an actor flies seeded episodes (optionally with DART noise), an expert
+"""Recording sessions: a pilot flies seeded episodes (optionally with DART noise), an expert
 labels every visited state, and every step goes to the session's MCAP log in seed order.
 
 Episodes are flown on worker processes when asked (``workers``); the log is written by this
@@ -7,125 +7,26 @@ process as results arrive in seed order, so it is identical to a one-worker sess
 
 from __future__ import annotations
 
-import os
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
-import numpy as np
-
+from gymfg_il.datasets import lerobot_api as lr
+from gymfg_il.datasets.features import check_compatible, dataset_features
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
-from gymfg_il.parallel import AgentSpec, EnvSpec, Workers, kept, map_seeds, release_kept
+from gymfg_il.recording.recorder import LOGS, new_log_path
+from gymfg_il.recording.session import session_record
 from gymfg_il.recording.writer import TrajectoryWriter
+from gymfg_il.rollout.agents import AgentSpec
+from gymfg_il.rollout.records import Episode
+from gymfg_il.rollout.seeded import iter_many
+from gymfg_il.workers import Workers
 
-LOGS, DATASET = "logs", "dataset"
-_LOW, _HIGH = np.array([-1.0, -1.0, -1.0, 0.0]), np.ones(4)
+DATASET = "dataset"
 
-
-@dataclass
-class FlownEpisode:
-    """Everything one episode logs (picklable, so workers can return it)."""
-
-    seed: int
-    target: float | None
-    initial_state: dict[str, float]
-    task: dict[str, Any]
-    observations: np.ndarray
-    states: np.ndarray
-    executed: np.ndarray
-    labels: np.ndarray
-    rewards: np.ndarray
-    terminated: bool
-    outcome: str
-
-    @property
-    def total_return(self) -> float:
-        return float(self.rewards.sum())
-
-
-def fly_and_label(
-    env_spec: EnvSpec, actor: AgentSpec, expert: AgentSpec | None, noise: float, seed: int
-) -> FlownEpisode:
-    """Fly one episode: ``actor`` chooses (plus Gaussian noise on the surfaces), ``expert``
-    labels each visited state (the actor's own clean action when there is no expert)."""
-
-    def build() -> tuple[Any, Any, Any]:
-        env = env_spec.make()
-        return env, actor.make(env), expert.make(env) if expert else None
-
-    key = repr((env_spec, actor.key(), expert.key() if expert else None))
-    env, pilot, teacher = kept(key, build)
-    rng = np.random.default_rng([seed, 7919])
-    obs, info = env.reset(seed=seed)
-    pilot.reset(seed)
-    if teacher is not None:
-        teacher.reset(seed)
-    slot = env.world.slots[0]
-    initial = dict(zip(("lat_deg", "lon_deg", "altitude_ft"), slot.state[:3].tolist(), strict=True))
-    observations, states, executed, labels, rewards = [], [], [], [], []
-    terminated = truncated = False
-    step_info: dict[str, Any] = {}
-    while not (terminated or truncated):
-        clean = np.clip(np.asarray(pilot.act(obs), dtype=np.float64), _LOW, _HIGH)
-        label = clean if teacher is None else np.clip(teacher.act(obs), _LOW, _HIGH)
-        action = clean
-        if noise:
-            action = clean.copy()
-            action[:3] += rng.normal(0.0, noise, 3)
-            action = np.clip(action, _LOW, _HIGH)
-        if teacher is not None and hasattr(teacher, "track"):
-            # the expert's integrators follow what was really flown, or the observed ones
-            teacher.track(action, from_observation=True)
-        observations.append(obs)
-        obs, reward, terminated, truncated, step_info = env.step(action)
-        states.append(slot.state)
-        executed.append(action)
-        labels.append(label)
-        rewards.append(reward)
-    outcome = step_info.get("reason", "terminated") if terminated else "time limit"
-    return FlownEpisode(
-        seed,
-        info["target"],
-        initial,
-        env.task.describe(),
-        np.array(observations),
-        np.array(states),
-        np.array(executed),
-        np.array(labels),
-        np.array(rewards),
-        bool(terminated),
-        outcome,
-    )
-
-
-def session_record(env_spec: EnvSpec, source: str, noise: float, **extra: Any) -> dict[str, Any]:
-    env = env_spec.make()
-    try:
-        doc = (type(env.task).__doc__ or env.task.name).strip().splitlines()[0]
-        return {
-            "env": {
-                "task": env_spec.task,
-                "aircraft": env_spec.aircraft,
-                "dynamic": env_spec.dynamic,
-                "task_kwargs": env_spec.task_kwargs,
-                "agent_hz": env_spec.agent_hz,
-                "sim_hz": 120,
-                "episode_time_s": env_spec.episode_time_s,
-            },
-            "aircraft": env.aircraft.model,
-            "task": env.task.name,
-            "task_description": f"{doc} ({env.aircraft.model})",
-            "observation_names": list(env.observation_names),
-            "agent_hz": env_spec.agent_hz,
-            "sim_hz": 120,
-            "source": source,
-            "noise": noise,
-            **extra,
-        }
-    finally:
-        env.close()
+__all__ = ["DATASET", "LOGS", "SessionResult", "check_appendable", "check_out_folder",
+           "record_session"]  # fmt: skip
 
 
 def check_out_folder(out: Path) -> None:
@@ -152,29 +53,20 @@ def check_appendable(out: Path, observation_names: Sequence[str], fps: int) -> N
     root = out / DATASET
     if not (root / "meta" / "info.json").is_file():
         return
-    from lerobot.datasets.dataset_metadata import LeRobotDatasetMetadata
-
-    from gymfg_il.datasets.features import check_compatible, dataset_features
-
-    meta = LeRobotDatasetMetadata("gymfg/check", root=root)
+    meta = lr.open_metadata(root)
     check_compatible(meta.features, dataset_features(observation_names), str(root))
     if meta.fps != fps:
         raise ConfigError(f"the dataset at {root} is at {meta.fps} fps, not {fps}")
 
 
-def new_log_path(out: Path, tag: str = "session") -> Path:
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    return out / LOGS / f"{tag}-{stamp}-{os.getpid()}-{time.time_ns() % 10**6:06d}.mcap"
-
-
 @dataclass
 class SessionResult:
     log: Path
-    episodes: list[FlownEpisode]
+    episodes: list[Episode]
 
     @property
     def steps(self) -> int:
-        return sum(len(e.rewards) for e in self.episodes)
+        return sum(e.steps for e in self.episodes)
 
     @property
     def returns(self) -> list[float]:
@@ -182,8 +74,8 @@ class SessionResult:
 
 
 def record_session(
-    env_spec: EnvSpec,
-    actor: AgentSpec,
+    flight: FlightSpec,
+    pilot: AgentSpec,
     expert: AgentSpec | None,
     seeds: Sequence[int],
     out: Path,
@@ -193,42 +85,17 @@ def record_session(
     iteration: int = 0,
     progress: Callable[[int, float], None] | None = None,
 ) -> SessionResult:
-    """Fly one episode per seed and log them to a new MCAP log under ``out/logs``."""
+    """Fly one episode of ``flight`` per seed and log them to a new MCAP log under
+    ``out/logs``; ``progress(i, return)`` is called once each episode is durable."""
     check_out_folder(out)
-    record = session_record(env_spec, source, noise, iteration=iteration)
-    check_appendable(out, record["observation_names"], env_spec.agent_hz)
-    path = new_log_path(out, source)
-    episodes: list[FlownEpisode] = []
-    try:
-        with TrajectoryWriter(path, record, ["ego"], 1.0 / env_spec.agent_hz) as writer:
-            for i, ep in enumerate(
-                map_seeds(fly_and_label, (env_spec, actor, expert, noise), seeds, workers)
-            ):
-                writer.start_episode(
-                    seed=ep.seed,
-                    task=ep.task,
-                    target=ep.target,
-                    initial_state=ep.initial_state,
-                    source=source,
-                    iteration=iteration,
-                )
-                n = len(ep.rewards)
-                for k in range(n):
-                    writer.log_step(
-                        "ego",
-                        k + 1,
-                        ep.states[k],
-                        ep.observations[k],
-                        ep.executed[k],
-                        ep.labels[k],
-                        ep.rewards[k],
-                        terminated=ep.terminated and k == n - 1,
-                        truncated=not ep.terminated and k == n - 1,
-                    )
-                writer.end_episode(outcome=ep.outcome, steps=n, interventions=0)
-                episodes.append(ep)
-                if progress is not None:
-                    progress(i, ep.total_return)
-    finally:
-        release_kept()
-    return SessionResult(path, episodes)
+    record = session_record(flight, source, noise=noise, iteration=iteration)
+    check_appendable(out, record["aircraft"]["ego"]["observation_names"], flight.agent_hz)
+    episodes: list[Episode] = []
+    flown = iter_many(flight, pilot, seeds, workers, expert=expert, noise=noise)
+    with TrajectoryWriter(new_log_path(out, source), record) as writer:
+        for i, episode in enumerate(flown):
+            writer.write_episode(episode, source=source, iteration=iteration)
+            episodes.append(episode)
+            if progress is not None:
+                progress(i, episode.total_return)
+    return SessionResult(writer.path, episodes)

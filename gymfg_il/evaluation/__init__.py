@@ -1,1 +1,2 @@
-"""Evaluation: fly agents on the same seeded cases, score them, report tables, JSON and plots."""
+"""Evaluation: fly agents on the same seeded cases (``runner``), score them (``trace``,
+``metrics``), and report tables, JSON rows and Figure-1 plots (``report``, ``plots``)."""

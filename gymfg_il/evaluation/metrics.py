@@ -21,7 +21,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from gymfg_il.evaluation.rollout import Episode
+from gymfg_il.evaluation.trace import Trace
 
 HOLD_S = 10.0
 TRACKING_FACTOR = 3.0
@@ -40,7 +40,7 @@ class EpisodeScore:
     terminated: bool
 
 
-def score_episode(ep: Episode, hold_s: float = HOLD_S) -> EpisodeScore:
+def score_episode(ep: Trace, hold_s: float = HOLD_S) -> EpisodeScore:
     abs_err = np.abs(ep.error)
     hold = max(1, round(hold_s / ep.dt))
     tail = abs_err[-hold:]
@@ -71,7 +71,7 @@ def _nanmean(values: list[float]) -> float:
 
 
 def summarize(
-    agent: str, task: str, aircraft: str, episodes: list[Episode], hold_s: float = HOLD_S
+    agent: str, task: str, aircraft: str, episodes: list[Trace], hold_s: float = HOLD_S
 ) -> dict[str, object]:
     """One row of the comparison table (the ``--json`` schema plus extra metrics)."""
     scores = [score_episode(ep, hold_s) for ep in episodes]

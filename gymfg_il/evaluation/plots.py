@@ -6,7 +6,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from gymfg_il.evaluation.rollout import CONTROL_NAMES, Episode
+from gymfg_il.evaluation.trace import Trace
+from gymfg_il.sim.properties import ACTION_NAMES
+
+# The surface that mainly drives each family (the paper's Figure 1 "control signal" column).
+PRIMARY_CONTROL = {"altitude": 1, "pitch": 1, "level": 1, "roll": 0, "heading": 0, "airspeed": 3}
 
 UNITS = {
     "altitude_ft": "ft",
@@ -17,7 +21,7 @@ UNITS = {
 }
 
 
-def figure1(episodes: Sequence[Episode], control: int, title: str, path: Path) -> Path:
+def figure1(episodes: Sequence[Trace], control: int, title: str, path: Path) -> Path:
     """Save the Figure-1 grid of ``episodes`` to ``path`` (PNG) and return the path."""
     import matplotlib
 
@@ -30,7 +34,7 @@ def figure1(episodes: Sequence[Episode], control: int, title: str, path: Path) -
         t = ep.time_s
         var = ep.variable
         row[0].plot(t, ep.actions[:, control], color="tab:blue", lw=1)
-        row[0].set_ylabel(f"seed {ep.seed}\n{CONTROL_NAMES[control]}")
+        row[0].set_ylabel(f"seed {ep.seed}\n{ACTION_NAMES[control]}")
         row[1].plot(t, ep.target, color="tab:red", lw=1.2, ls="--", label="target")
         row[1].plot(t, ep.value, color="tab:green", lw=1, label=var)
         row[1].set_ylabel(f"{var.rsplit('_', 1)[0]} ({UNITS.get(var, '')})")

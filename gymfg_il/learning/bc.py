@@ -3,18 +3,20 @@
 from __future__ import annotations
 
 import json
+import logging
 import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
 from gymfg_il.errors import ConfigError, join_problems
 
 DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -38,7 +40,7 @@ class TrainConfig:
 
     dataset: Path = DEFAULT_DATASET
     out: Path | None = None
-    policy: str = "mlp"
+    policy: Literal["mlp", "gru"] = "mlp"
     epochs: int = 30
     batch_size: int = 256
     lr: float = 1e-3
@@ -84,20 +86,6 @@ def resolve_device(device: str) -> str:
     if device.startswith("cuda") and not torch.cuda.is_available():
         raise ConfigError(f"device={device!r} but no CUDA device is available; use cpu")
     return device
-
-
-def env_of(frames: Any) -> dict[str, Any]:
-    """The task family, dynamic switch and aircraft the dataset was recorded on."""
-    tasks = set(frames.episodes.get("gymfg/task", []))
-    aircraft = set(frames.episodes.get("gymfg/aircraft", []))
-    if len(tasks) != 1 or len(aircraft) != 1:
-        return {"task": None, "dynamic": False, "aircraft": None}
-    task = tasks.pop()
-    return {
-        "task": task.removesuffix("-dynamic"),
-        "dynamic": task.endswith("-dynamic"),
-        "aircraft": aircraft.pop(),
-    }
 
 
 def train_bc(
@@ -147,15 +135,21 @@ def train_bc(
         if on_epoch is not None:
             on_epoch(epoch, train_loss[-1], val_loss[-1])
     seconds = time.perf_counter() - started
-    env = env_of(frames)
-    name = (
-        f"bc-{env['task'] or 'task'}{'-dynamic' if env['dynamic'] else ''}-"
-        f"{env['aircraft'] or 'aircraft'}-{cfg.policy}"
-    )
+    flight, why = frames.flight()
+    if flight is None:
+        log.warning(
+            "the policy records no flight spec: %s; eval will need --task and --aircraft", why
+        )
+    label = flight.task_label if flight else "task"
+    name = f"bc-{label}-{flight.aircraft if flight else 'aircraft'}-{cfg.policy}"
     out = Path(cfg.out) if cfg.out is not None else Path("policies") / name
     meta = {
         "name": name,
-        **env,
+        # what the policy flies: the whole spec, and its names for a reader of the file
+        "spec": flight.to_dict() if flight else None,
+        "task": flight.task if flight else None,
+        "dynamic": flight.dynamic if flight else False,
+        "aircraft": flight.aircraft if flight else None,
         "observation_names": frames.observation_names,
         "action_names": frames.action_names,
         "fps": frames.fps,

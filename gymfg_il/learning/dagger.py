@@ -8,11 +8,61 @@ import shutil
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from gymfg_il.collectors.session import DATASET, LOGS, record_session
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
-from gymfg_il.parallel import AgentSpec, EnvSpec, Workers
+from gymfg_il.rollout.agents import AgentSpec
+from gymfg_il.workers import Workers
+
+
+@dataclass
+class DaggerConfig:
+    """DAgger rounds from a trained policy (``collect dagger``).
+
+    Attributes:
+        policy: checkpoint to start from; it flies its own flight spec (aircraft, task and
+            options, rate, episode time).
+        out: session folder: logs/, dataset/ (the aggregate), policy-<k>/.
+        expert: who labels the visited states: the task's controller.
+        iterations: rounds of fly / label / aggregate / retrain.
+        episodes: episodes per round.
+        seed: seed of the first episode (the rounds take the seeds that follow).
+        epochs: training epochs per round (default: the policy's own).
+        workers: worker processes flying episodes.
+    """
+
+    policy: Path
+    out: Path
+    expert: Literal["controller"] = "controller"
+    iterations: int = 3
+    episodes: int = 10
+    seed: int = 2000
+    epochs: int | None = None
+    workers: int = 1
+
+    def __post_init__(self) -> None:
+        self.policy, self.out = Path(self.policy), Path(self.out)
+        bad = [
+            f"{k}={getattr(self, k)!r}"
+            for k in ("iterations", "episodes", "workers")
+            if not isinstance(getattr(self, k), int) or getattr(self, k) < 1
+        ]
+        if self.epochs is not None and self.epochs < 1:
+            bad.append(f"epochs={self.epochs!r}")
+        if bad:
+            raise ConfigError(f"dagger: {', '.join(bad)} must be integers >= 1")
+
+    def run(
+        self, on_iteration: Callable[[DaggerIteration], None] | None = None
+    ) -> list[DaggerIteration]:
+        """``run_dagger`` with these settings."""
+        overrides = {"epochs": self.epochs} if self.epochs else {}
+        return run_dagger(
+            self.policy, self.out, self.iterations, self.episodes, self.seed, self.workers,
+            overrides, on_iteration,
+        )  # fmt: skip
 
 
 @dataclass
@@ -42,9 +92,13 @@ def run_dagger(
     if iterations < 1 or episodes < 1:
         raise ConfigError("iterations and episodes must be >= 1")
     meta = AgentSpec.policy(policy).meta()
-    if not meta.get("task") or not meta.get("aircraft"):
-        raise ConfigError(f"{policy} does not record its task and aircraft; DAgger needs them")
-    spec = EnvSpec(meta["task"], meta["aircraft"], bool(meta.get("dynamic")), int(meta["fps"]))
+    if not meta.get("spec"):
+        raise ConfigError(
+            f"{policy} records no flight spec (trained on a dataset made before gymfg-il 0.2); "
+            "DAgger flies the policy's own flight: rebuild the dataset with `collect recover` "
+            "and train again"
+        )
+    flight = FlightSpec.from_dict(meta["spec"])
     root = out / DATASET
     base = Path(meta.get("dataset", ""))
     if not root.exists():
@@ -62,7 +116,7 @@ def run_dagger(
         for it in range(1, iterations + 1):
             seeds = range(seed + (it - 1) * episodes, seed + it * episodes)
             session = record_session(
-                spec,
+                flight,
                 AgentSpec.policy(current),
                 AgentSpec.controller(),
                 seeds,

@@ -7,7 +7,6 @@ window starts, for recurrent policies); a batch is one gather.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.datasets import lerobot_api as lr
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
-
-os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 
 @dataclass
@@ -37,6 +36,21 @@ class Frames:
 
     def __len__(self) -> int:
         return len(self.action)
+
+    def flight(self) -> tuple[FlightSpec | None, str]:
+        """The solo flight every episode was flown as (a team run's aircraft on its own), and
+        why there is none when the episodes disagree or predate flight specs."""
+        specs = self.episodes.get("gymfg/spec")
+        if not specs:
+            return None, "its episodes record no flight spec (made before gymfg-il 0.2)"
+        callsigns = self.episodes.get("gymfg/callsign") or ["ego"] * len(specs)
+        found = {
+            FlightSpec.from_json(text).for_callsign(c).to_json()
+            for text, c in set(zip(specs, callsigns, strict=True))
+        }
+        if len(found) > 1:
+            return None, f"its episodes were flown with {len(found)} different flight specs"
+        return FlightSpec.from_json(found.pop()), ""
 
     def select(self, episodes: np.ndarray) -> Frames:
         keep = np.isin(self.episode, episodes)
@@ -74,9 +88,7 @@ def load_frames(root: Path) -> Frames:
             f"no LeRobot dataset at {root} (no meta/info.json); collect one with "
             "`python -m gymfg_il.collect autopilot --out DIR` and pass DIR/dataset"
         )
-    from lerobot.datasets.lerobot_dataset import LeRobotDataset
-
-    ds = LeRobotDataset("gymfg/local", root=root, video_backend="pyav")
+    ds = lr.open_dataset(root)
     features = ds.meta.features
     for key in ("observation.state", "action"):
         if key not in features:

@@ -119,3 +119,24 @@ def test_sigkill_at_random_moments_loses_no_completed_episode(tmp_path):
         assert len(ds) == ds.num_episodes * 100
     assert reported_total > 0
     assert not list(tmp_path.glob("session/dataset.*"))  # no half-built copies left behind
+
+
+def test_replay_into_a_view_sends_every_step_and_checks_every_state(tmp_path, capsys):
+    import socket
+
+    out = tmp_path / "session"
+    assert collect.main(["autopilot", "--out", str(out), "--episodes", "1", "--episode-time",
+                         "2", "--no-progress"]) == 0  # fmt: skip
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as view:
+        view.bind(("127.0.0.1", 0))
+        port = view.getsockname()[1]
+        assert collect.main(["replay", str(out), "--view", str(port)]) == 0
+        view.settimeout(0.5)
+        packets = []
+        while True:
+            try:
+                packets.append(view.recv(2048))
+            except TimeoutError:
+                break
+    assert "ego: 20 steps, identical" in capsys.readouterr().out
+    assert len(packets) == 21 and {len(p) for p in packets} == {408}  # the reset, then 20 steps

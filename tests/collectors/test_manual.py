@@ -8,12 +8,12 @@ import pytest
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 import pygame
 
+from gymfg_il.collectors.manual import ManualSession
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.data import load_frames
-from gymfg_il.manual.session import ManualSession
-from gymfg_il.parallel import EnvSpec
 
-SPEC = EnvSpec("altitude", "c172p", episode_time_s=3, agent_hz=30)  # 90 frames an episode
+SPEC = FlightSpec.solo("c172p", "altitude", episode_time_s=3, agent_hz=30)  # 90 frames an episode
 
 
 def key(k, down=True):
@@ -136,7 +136,7 @@ def test_discarded_episode_is_flown_again_with_its_seed(tmp_path):
 
 def test_appending_another_task_is_refused(tmp_path):
     run(tmp_path, {1: [lambda: key(pygame.K_SPACE)], 200: [lambda: key(pygame.K_q)]})
-    roll = EnvSpec("roll", "c172p", episode_time_s=3, agent_hz=30)
+    roll = FlightSpec.solo("c172p", "roll", episode_time_s=3, agent_hz=30)
     with pytest.raises(ConfigError, match="features differ"):
         ManualSession(roll, tmp_path, realtime=False)
 

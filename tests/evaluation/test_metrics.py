@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from gymfg_il.evaluation.metrics import score_episode, summarize
-from gymfg_il.evaluation.rollout import Episode
+from gymfg_il.evaluation.trace import Trace
 
 
 def episode(error, dynamic=False, terminated=False, tolerance=1.0):
@@ -12,7 +12,7 @@ def episode(error, dynamic=False, terminated=False, tolerance=1.0):
     n = len(error)
     actions = np.zeros((n, 4))
     actions[:, 1] = np.linspace(0, 0.1, n)
-    return Episode(
+    return Trace(
         seed=3,
         variable="roll_deg",
         tolerance=tolerance,

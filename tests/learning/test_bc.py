@@ -6,10 +6,15 @@ import pytest
 from gymfg_il.controllers.agent import ConstantAgent
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.errors import ConfigError
-from gymfg_il.evaluation.rollout import fly_episode
+from gymfg_il.evaluation.trace import trace_of
 from gymfg_il.learning.bc import TrainConfig, train_bc
 from gymfg_il.learning.data import TensorBatches, load_frames, split_by_episode
 from gymfg_il.policies.agent import PolicyAgent
+from gymfg_il.rollout import Rollout
+
+
+def fly_episode(env, agent, seed):
+    return trace_of(Rollout(env, [agent]).episode(seed))
 
 
 @pytest.fixture(scope="module")

@@ -4,12 +4,12 @@ import numpy as np
 
 from gymfg_il.collectors.autopilot import record_autopilot
 from gymfg_il.collectors.config import CollectConfig
-from gymfg_il.collectors.dagger import run_dagger
 from gymfg_il.datasets.from_logs import build_from_logs
-from gymfg_il.evaluation.parallel import fly_many
+from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.learning.bc import TrainConfig, train_bc
+from gymfg_il.learning.dagger import run_dagger
 from gymfg_il.learning.data import load_frames
-from gymfg_il.parallel import AgentSpec, EnvSpec
+from gymfg_il.rollout import AgentSpec, fly_many
 
 
 def test_dagger_beats_plain_bc(tmp_path):
@@ -35,7 +35,7 @@ def test_dagger_beats_plain_bc(tmp_path):
         seed=2000,
         train_overrides={"epochs": 40},
     )
-    spec = EnvSpec("heading", "c172p", episode_time_s=40)
+    spec = FlightSpec.solo("c172p", "heading", episode_time_s=40)
     seeds = range(5)
     bc_return = np.mean([e.total_return for e in fly_many(spec, AgentSpec.policy(bc.out), seeds)])
     dagger_return = np.mean(
@@ -45,3 +45,34 @@ def test_dagger_beats_plain_bc(tmp_path):
     frames = load_frames(tmp_path / "dagger" / "dataset")
     assert frames.episodes["gymfg/source"].count("dagger") == 8
     assert sorted(set(frames.episodes["gymfg/iteration"])) == [0, 1, 2]
+
+
+def test_dagger_flies_the_policys_own_flight(tmp_path):
+    from gymfg_il.collectors.autopilot import collect_autopilot
+    from gymfg_il.recording.reader import read_log
+
+    demo = CollectConfig(
+        task="altitude",
+        episodes=2,
+        episode_time_s=7,
+        agent_hz=20,
+        task_kwargs={"target_range": [-300.0, 300.0], "tolerance": 20.0},
+        seed=1000,
+        out=tmp_path / "demo",
+    )
+    collect_autopilot(demo)
+    bc = train_bc(TrainConfig(dataset=tmp_path / "demo" / "dataset", out=tmp_path / "bc", epochs=1))
+    history = run_dagger(
+        bc.out, tmp_path / "dagger", iterations=1, episodes=2, train_overrides={"epochs": 1}
+    )
+    (log_path,) = (tmp_path / "dagger" / "logs").glob("dagger-*.mcap")
+    log = read_log(log_path)
+    assert log.spec == demo.flight()  # episode time, rate and task options all kept
+    for ep in log.complete_episodes:
+        steps = ep.steps["ego"]
+        assert len(steps) == 7 * 20
+        start = ep.start_of("ego")
+        assert abs(start["target"] - start["initial_state"]["altitude_ft"]) <= 300
+    assert log.aircraft("ego")["task"]["tolerance"] == 20.0
+    retrained = AgentSpec.policy(history[-1].policy).meta()
+    assert FlightSpec.from_dict(retrained["spec"]) == demo.flight()

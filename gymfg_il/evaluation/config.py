@@ -1,0 +1,142 @@
+"""What an evaluation run is (``python -m gymfg_il.eval`` is built from it), and running it:
+the plan (what flies, on which seeds), the flights, and the JSON and plots it writes."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.evaluation.runner import evaluate, flight_for
+from gymfg_il.evaluation.trace import Trace
+from gymfg_il.rollout.agents import AgentSpec
+from gymfg_il.workers import Workers
+
+TASKS = ("altitude", "roll", "pitch", "heading", "airspeed", "level")
+
+
+@dataclass
+class EvalConfig:
+    """An evaluation: the task's controller and each policy fly the same seeded episodes.
+
+    Attributes:
+        policy: a trained policy (checkpoint folder) to fly beside the controller;
+            repeatable. A policy flies its own flight (aircraft, task and options, agent
+            rate, episode time, from its config.json) unless a flag below changes it.
+        task: task family: altitude, roll, pitch, heading, airspeed, level (default: the
+            policy's, else altitude).
+        dynamic: moving targets (the family's dynamic task) instead of fixed ones (default:
+            the policy's, else fixed).
+        aircraft: JSBSim model: c172p, f15, A320 or any other JSBSim ships (default: the
+            policy's, else c172p).
+        episodes: episodes per agent.
+        seed: seed of the first episode; episode i uses seed+i (the bundled demonstrations
+            use seeds from 1000, so the default seeds are held out).
+        episode_time_s: episode length in seconds (default: the policy's, else 90).
+        agent_hz: agent rate in Hz, a divisor of 120 (default: the policy's, else 10; a
+            policy is not flown at another rate than it was trained at).
+        workers: worker processes flying episodes in parallel; results are identical to one
+            worker.
+        json: write the rows as JSON to this file.
+        plots: write Figure-1 plots (one PNG per agent) to this folder.
+        plot_episodes: episodes (rows) per plot.
+    """
+
+    policy: list[Path] = field(default_factory=list, metadata={"repeat": True})
+    task: str | None = None
+    dynamic: bool | None = None
+    aircraft: str | None = None
+    episodes: int = 10
+    seed: int = 0
+    episode_time_s: float | None = field(default=None, metadata={"flag": "--episode-time"})
+    agent_hz: int | None = None
+    workers: int = 1
+    json: Path | None = None
+    plots: Path | None = None
+    plot_episodes: int = 4
+
+    def __post_init__(self) -> None:
+        self.policy = [Path(p) for p in self.policy]
+        problems = []
+        if self.task is not None and self.task not in TASKS:
+            problems.append(f"task={self.task!r}: choose one of {', '.join(TASKS)}")
+        for name in ("episodes", "workers", "plot_episodes"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                problems.append(f"{name}={value!r} must be an integer >= 1")
+        if problems:
+            raise ConfigError(join_problems("eval", problems))
+
+    @property
+    def seeds(self) -> list[int]:
+        return list(range(self.seed, self.seed + self.episodes))
+
+
+@dataclass
+class EvalRun:
+    """What an evaluation flew and found."""
+
+    flight: FlightSpec
+    rows: list[dict[str, Any]]
+    traces: dict[str, list[Trace]]
+    notes: list[str]
+    written: list[Path] = field(default_factory=list)
+
+
+def plan(cfg: EvalConfig) -> tuple[FlightSpec, dict[str, AgentSpec], list[str]]:
+    """What flies (the flight, the agents by row name) and the notes on flags that changed a
+    policy's own flight; a clear error for a policy that cannot fly it."""
+    from gymfg_il.policies.agent import PolicyAgent
+
+    metas = {path: AgentSpec.policy(path).meta() for path in cfg.policy}
+    flight, notes = flight_for(
+        metas,
+        task=cfg.task,
+        dynamic=cfg.dynamic,
+        aircraft=cfg.aircraft,
+        agent_hz=cfg.agent_hz,
+        episode_time_s=cfg.episode_time_s,
+    )
+    env = flight.make_env()
+    try:
+        for meta in metas.values():
+            PolicyAgent(None, meta).check_observation(env.observation_names)
+    finally:
+        env.close()
+    agents = {"controller": AgentSpec.controller()}
+    for path in cfg.policy:
+        agents[f"policy:{path.name}"] = AgentSpec.policy(path)
+    return flight, agents, notes
+
+
+def run_eval(
+    cfg: EvalConfig, progress: Callable[[int], Callable[[str], None]] | None = None
+) -> EvalRun:
+    """Plan, fly every agent on ``cfg.seeds`` and write the JSON rows and plots asked for.
+
+    ``progress(total)`` is called once the workers run (a bar made earlier would start a
+    thread, and workers then could not be forked) and returns the per-episode callback."""
+    flight, agents, notes = plan(cfg)
+    seeds = cfg.seeds
+    with Workers(min(cfg.workers, len(seeds))) as pool:
+        tick = progress(len(agents) * len(seeds)) if progress else None
+        rows, traces = evaluate(flight, agents, seeds, pool, tick)
+    run = EvalRun(flight, rows, traces, notes)
+    if cfg.json:
+        cfg.json.parent.mkdir(parents=True, exist_ok=True)
+        cfg.json.write_text(json.dumps({"rows": rows}, indent=2))
+        run.written.append(cfg.json)
+    if cfg.plots:
+        from gymfg_il.evaluation.plots import PRIMARY_CONTROL, figure1
+
+        label, model = flight.task_label, flight.aircraft
+        for name, episodes in traces.items():
+            path = cfg.plots / f"{label}_{model}_{name.replace(':', '-')}.png"
+            title = f"{name}: {label} on {model}"
+            figure1(episodes[: cfg.plot_episodes], PRIMARY_CONTROL[flight.task], title, path)
+            run.written.append(path)
+    return run
