@@ -1,17 +1,29 @@
-"""Command lines built from config dataclasses: one flag per field, its help taken from the
-``Attributes:`` section of the class docstring (so the docs and ``--help`` cannot drift)."""
+"""Command lines built from config dataclasses, one way for every command: one ``--flag`` per
+field, its help taken from the ``Attributes:`` section of the class docstring and its default
+printed beside it (so the docs, the defaults and ``--help`` cannot drift).
+
+Field types decide the flag: ``bool`` is ``--x/--no-x``; ``Literal[...]`` lists its choices;
+``list[T]`` takes several values; ``T | None`` is optional. A field's ``metadata`` may rename
+its flag (``{"flag": "--episode-time"}``) or keep it off the command line (``{"cli": False}``).
+"""
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
 import re
+import sys
+import types
 import typing
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+SUPPRESS = argparse.SUPPRESS
+
 
 def field_docs(cls: type) -> dict[str, str]:
+    """Field name -> its line(s) in the ``Attributes:`` section of ``cls``'s docstring."""
     doc = cls.__doc__ or ""
     section = doc.split("Attributes:", 1)[1] if "Attributes:" in doc else ""
     docs: dict[str, str] = {}
@@ -23,42 +35,113 @@ def field_docs(cls: type) -> dict[str, str]:
             docs[current] = m.group(2).strip()
         elif current and line.strip():
             docs[current] += " " + line.strip()
-    return docs
+    return {k: v.replace("``", "") for k, v in docs.items()}
 
 
-def add_dataclass_args(
-    parser: argparse.ArgumentParser, cls: type, skip: tuple[str, ...] = ()
+def summary(cls: type) -> str:
+    """The docstring of ``cls`` up to its ``Attributes:`` section, on one line."""
+    text = (cls.__doc__ or "").split("Attributes:", 1)[0]
+    return " ".join(text.split())
+
+
+def _default(f: dataclasses.Field[Any]) -> Any:
+    if f.default is not dataclasses.MISSING:
+        return f.default
+    if f.default_factory is not dataclasses.MISSING:
+        return f.default_factory()
+    return None
+
+
+def parser(prog: str, doc: str | None, epilog: str | None = None) -> argparse.ArgumentParser:
+    """A parser whose description is ``doc`` as written."""
+    return argparse.ArgumentParser(
+        prog=prog,
+        description=doc,
+        epilog=epilog,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+
+
+def add_fields(
+    p: argparse.ArgumentParser,
+    cls: type,
+    *,
+    only: tuple[str, ...] | None = None,
+    skip: tuple[str, ...] = (),
+    defaults: Mapping[str, Any] | None = None,
+    flags: Mapping[str, str] | None = None,
+    overrides_only: bool = False,
 ) -> None:
-    """One ``--field-name`` per dataclass field; lists take several values, bools are flags."""
+    """One flag per field of the dataclass ``cls`` (``only``/``skip`` choose the fields;
+    ``defaults`` and ``flags`` change a field's default and flag name for this command;
+    ``overrides_only``: a flag left out is absent from the namespace, e.g. recipe overrides)."""
     docs = field_docs(cls)
     hints = typing.get_type_hints(cls)
+    defaults, flags = dict(defaults or {}), dict(flags or {})
     for f in dataclasses.fields(cls):
-        if f.name in skip:
+        if f.name in skip or (only is not None and f.name not in only):
             continue
-        default = (
-            f.default
-            if f.default is not dataclasses.MISSING
-            else (f.default_factory() if f.default_factory is not dataclasses.MISSING else None)
-        )
+        if not f.metadata.get("cli", True):
+            continue
+        default = defaults.get(f.name, _default(f))
+        flag = flags.get(f.name) or f.metadata.get("flag") or "--" + f.name.replace("_", "-")
         kind = hints[f.name]
-        origin = typing.get_origin(kind)
         args = [a for a in typing.get_args(kind) if a is not type(None)]
-        flag = "--" + f.name.replace("_", "-")
-        text = f"{docs.get(f.name, '')} (default: {default})".replace("%", "%%")
+        origin = typing.get_origin(kind)
+        if origin in (typing.Union, types.UnionType) and args:
+            kind, origin = args[0], typing.get_origin(args[0])
+            args = list(typing.get_args(args[0]))
+        text = docs.get(f.name, "")
+        if default is not None and default != [] and default != {}:
+            shown = default.__name__ if isinstance(default, type) else default
+            text += f" (default: {shown})"
+        options: dict[str, Any] = {
+            "help": text.replace("%", "%%"),
+            "default": SUPPRESS if overrides_only else default,
+            "dest": f.name,
+        }
+        required = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+        if f.metadata.get("positional"):
+            flag = f.name
+            del options["dest"]
+            if not required:
+                options["nargs"] = "?"
+        elif required and not overrides_only:
+            options["required"] = True
         if kind is bool:
-            parser.add_argument(
-                flag, action=argparse.BooleanOptionalAction, default=default, help=text
-            )
-        elif origin is list:
-            parser.add_argument(flag, nargs="+", type=args[0], default=default, help=text)
-        else:
-            base: Any = args[0] if args else kind
-            if base not in (int, float, str, Path):
-                base = str
-            parser.add_argument(flag, type=base, default=default, help=text)
+            p.add_argument(flag, action=argparse.BooleanOptionalAction, **options)
+        elif origin is typing.Literal:
+            p.add_argument(flag, choices=list(typing.get_args(kind)), **options)
+        elif origin in (list, tuple):
+            # a repeatable flag gathers every use (--policy A --policy B); others take one list
+            action = "extend" if f.metadata.get("repeat") else "store"
+            p.add_argument(flag, nargs="+", type=args[0] if args else str, action=action, **options)
+        elif kind in (int, float, str, Path):
+            p.add_argument(flag, type=kind, **options)
+        else:  # dict-valued and other structured fields come from recipes, not flags
+            continue
 
 
-def dataclass_from_args(cls: type, ns: argparse.Namespace, **extra: Any) -> Any:
+def build(cls: type, ns: argparse.Namespace, **extra: Any) -> Any:
+    """An instance of ``cls`` from the namespace's values of its fields (and ``extra``)."""
     names = {f.name for f in dataclasses.fields(cls)}
     values = {k: v for k, v in vars(ns).items() if k in names}
     return cls(**{**values, **extra})
+
+
+def run(main: Callable[[], int]) -> int:
+    """Run an entry point: a project error is one line on stderr and exit status 2."""
+    from gymfg_il.errors import GymFGError
+
+    try:
+        return main()
+    except GymFGError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+
+
+def progress_bar(total: int, desc: str, unit: str, enabled: bool = True) -> Any:
+    """A tqdm bar on stderr (disabled: nothing is drawn)."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, unit=unit, disable=not enabled, file=sys.stderr)

@@ -2,8 +2,8 @@
 
 1. demonstrations: the bundled sample dataset (autopilot, altitude task, c172p), collected
    again by its recipe if it is missing;
-2. ``train bc``: an MLP policy on it;
-3. ``eval``: the policy against the controller on held-out seeds (the demonstrations used
+2. behaviour cloning: an MLP policy on it;
+3. evaluation: the policy against the controller on held-out seeds (the demonstrations used
    seeds from 1000; evaluation uses 0..N-1);
 4. a report (table, JSON, Figure-1 plots, loss curve) written under ``runs/`` and its path
    printed.
@@ -11,111 +11,107 @@
 
 from __future__ import annotations
 
-import argparse
 import json
 import shutil
 import sys
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 RECIPE = Path("collectors/sample.toml")
 
 
-def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(
-        prog="python -m gymfg_il.demo",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
-    p.add_argument(
-        "--dataset",
-        type=Path,
-        default=Path("datasets/sample-altitude-c172p/dataset"),
-        help="demonstrations to learn from (default: the bundled sample)",
-    )
-    p.add_argument("--epochs", type=int, default=30, help="training epochs (default: 30)")
-    p.add_argument(
-        "--episodes", type=int, default=10, help="held-out evaluation episodes (default: 10)"
-    )
-    p.add_argument(
-        "--workers", type=int, default=2, help="evaluation worker processes (default: 2)"
-    )
-    p.add_argument(
-        "--runs",
-        type=Path,
-        default=Path("runs"),
-        help="where the report folder goes (default: runs/)",
-    )
-    p.add_argument("--no-progress", action="store_true", help="no progress bars")
-    return p.parse_args(argv)
+@dataclass
+class DemoConfig:
+    """The demo run.
+
+    Attributes:
+        dataset: demonstrations to learn from (the bundled sample by default).
+        epochs: training epochs.
+        episodes: held-out evaluation episodes.
+        workers: evaluation worker processes.
+        runs: where the report folder goes.
+        progress: progress bars.
+    """
+
+    dataset: Path = Path("datasets/sample-altitude-c172p/dataset")
+    epochs: int = 30
+    episodes: int = 10
+    workers: int = 2
+    runs: Path = Path("runs")
+    progress: bool = True
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = parse_args(argv)
-    from gymfg_il import collect, train
-    from gymfg_il import eval as evaluate
+    from gymfg_il import cli
 
+    p = cli.parser("python -m gymfg_il.demo", __doc__)
+    cli.add_fields(p, DemoConfig)
+    args = p.parse_args(argv)
+    return cli.run(lambda: run(cli.build(DemoConfig, args)))
+
+
+def _bar(show: bool, unit: str) -> Callable[[int], Callable[..., None]]:
+    from gymfg_il import cli
+
+    def progress(total: int) -> Callable[..., None]:
+        bar = cli.progress_bar(total, unit + "s", unit, show)
+
+        def tick(*_: object) -> None:
+            bar.update(1)
+            if bar.n == total:
+                bar.close()
+
+        return tick
+
+    return progress
+
+
+def run(cfg: DemoConfig) -> int:
+    from gymfg_il.datasets.lerobot_api import hub_offline
+    from gymfg_il.evaluation.config import EvalConfig, run_eval
+    from gymfg_il.learning.bc import TrainConfig, train_bc
+
+    hub_offline()
     started = time.perf_counter()
-    quiet = ["--no-progress"] if args.no_progress else []
-    run = args.runs / time.strftime("%Y%m%d-%H%M%S")
-    run.mkdir(parents=True, exist_ok=True)
-    if not (args.dataset / "meta" / "info.json").is_file():
-        print(f"[1/3] {args.dataset} is missing: collecting it with {RECIPE}", flush=True)
-        out = args.dataset.parent
-        if (
-            collect.main([str(RECIPE), "--out", str(out), "--workers", str(args.workers), *quiet])
-            != 0
-        ):
-            return 1
+    run_dir = cfg.runs / time.strftime("%Y%m%d-%H%M%S")
+    run_dir.mkdir(parents=True, exist_ok=True)
+    if not (cfg.dataset / "meta" / "info.json").is_file():
+        from gymfg_il.collectors.autopilot import collect_autopilot
+        from gymfg_il.collectors.config import CollectConfig
+
+        print(f"[1/3] {cfg.dataset} is missing: collecting it with {RECIPE}", flush=True)
+        recipe = CollectConfig.from_recipe(RECIPE, out=cfg.dataset.parent)
+        collect_autopilot(recipe, cfg.workers, _bar(cfg.progress, "episode"))
     else:
-        print(f"[1/3] demonstrations: {args.dataset}", flush=True)
-    policy = run / "policy"
+        print(f"[1/3] demonstrations: {cfg.dataset}", flush=True)
+    policy = run_dir / "policy"
     print(f"[2/3] behaviour cloning -> {policy}", flush=True)
-    if (
-        train.main(
-            [
-                "bc",
-                "--dataset",
-                str(args.dataset),
-                "--out",
-                str(policy),
-                "--epochs",
-                str(args.epochs),
-                *quiet,
-            ]
-        )
-        != 0
-    ):
-        return 1
-    print(f"[3/3] evaluating against the controller on {args.episodes} held-out seeds", flush=True)
-    if (
-        evaluate.main(
-            [
-                "--policy",
-                str(policy),
-                "--episodes",
-                str(args.episodes),
-                "--workers",
-                str(args.workers),
-                "--json",
-                str(run / "eval.json"),
-                "--plots",
-                str(run / "plots"),
-                *quiet,
-            ]
-        )
-        != 0
-    ):
-        return 1
-    write_report(run, policy, time.perf_counter() - started)
-    print(f"\nreport: {run / 'report.md'}  ({time.perf_counter() - started:.0f} s in all)")
+    train = TrainConfig(dataset=cfg.dataset, out=policy, epochs=cfg.epochs)
+    epoch_tick = _bar(cfg.progress, "epoch")(cfg.epochs)
+    trained = train_bc(train, lambda *_: epoch_tick())
+    print(f"      validation loss {trained.val_loss[-1]:.4f}", flush=True)
+    print(f"[3/3] evaluating against the controller on {cfg.episodes} held-out seeds", flush=True)
+    evaluation = EvalConfig(
+        policy=[policy],
+        episodes=cfg.episodes,
+        workers=cfg.workers,
+        json=run_dir / "eval.json",
+        plots=run_dir / "plots",
+    )
+    result = run_eval(evaluation, _bar(cfg.progress, "episode"))
+    write_report(run_dir, policy, result.rows, time.perf_counter() - started)
+    from gymfg_il.evaluation.report import table
+
+    print(table(result.rows))
+    print(f"\nreport: {run_dir / 'report.md'}  ({time.perf_counter() - started:.0f} s in all)")
     return 0
 
 
-def write_report(run: Path, policy: Path, seconds: float) -> None:
+def write_report(run: Path, policy: Path, rows: list[dict[str, object]], seconds: float) -> None:
     from gymfg_il.evaluation.report import table
 
-    rows = json.loads((run / "eval.json").read_text())["rows"]
     meta = json.loads((policy / "config.json").read_text())
     shutil.copy(policy / "loss.png", run / "loss.png")
     plots = sorted(p.relative_to(run) for p in (run / "plots").glob("*.png"))
@@ -125,7 +121,7 @@ def write_report(run: Path, policy: Path, seconds: float) -> None:
         f"Behaviour cloning ({meta['type']}) on `{meta['dataset']}` "
         f"({meta['train']['frames']} training frames, {meta['train']['epochs']} epochs), "
         f"evaluated on {rows[0]['episodes']} held-out seeds of the {rows[0]['task']} task on "
-        f"{rows[0]['aircraft']}.",
+        f"{rows[0]['aircraft']} at {rows[0]['agent_hz']} Hz.",
         "",
         "```",
         table(rows),

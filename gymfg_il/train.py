@@ -1,23 +1,20 @@
 """``python -m gymfg_il.train bc``: behaviour cloning on a LeRobot dataset.
 
 With no options it trains an MLP on the bundled sample dataset and saves it under policies/.
+The policy keeps the dataset's flight spec (aircraft, task, rate, episode time) in its
+config.json, so ``eval --policy`` and ``collect dagger --policy`` fly it as it was recorded.
 """
 
 from __future__ import annotations
 
-import argparse
 import sys
 
 
-def parse_args(argv: list[str]) -> argparse.Namespace:
-    from gymfg_il.cli import add_dataclass_args
+def main(argv: list[str] | None = None) -> int:
+    from gymfg_il import cli
     from gymfg_il.learning.bc import TrainConfig
 
-    p = argparse.ArgumentParser(
-        prog="python -m gymfg_il.train",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = cli.parser("python -m gymfg_il.train", __doc__)
     sub = p.add_subparsers(dest="algorithm", metavar="{bc}")
     bc = sub.add_parser(
         "bc",
@@ -25,38 +22,30 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         description="Train a behaviour-cloning policy on a LeRobot dataset; "
         "saves config.json, model.safetensors and loss.png.",
     )
-    add_dataclass_args(bc, TrainConfig)
+    cli.add_fields(bc, TrainConfig)
     bc.add_argument("--no-progress", action="store_true", help="no progress bar")
-    args = p.parse_args(argv)
+    args = p.parse_args(list(sys.argv[1:] if argv is None else argv))
     if args.algorithm is None:
         p.print_help()
-        p.exit(2)
-    return args
+        return 2
+    return cli.run(lambda: _bc(cli.build(TrainConfig, args), not args.no_progress))
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = parse_args(list(sys.argv[1:] if argv is None else argv))
-    from gymfg_il.cli import dataclass_from_args
-    from gymfg_il.errors import GymFGError
+def _bc(cfg: object, show_progress: bool) -> int:
+    from gymfg_il import cli
+    from gymfg_il.datasets.lerobot_api import hub_offline
     from gymfg_il.learning.bc import TrainConfig, train_bc
 
-    try:
-        cfg = dataclass_from_args(TrainConfig, args)
-        from tqdm import tqdm
+    assert isinstance(cfg, TrainConfig)
+    hub_offline()
+    bar = cli.progress_bar(cfg.epochs, "epochs", "ep", show_progress)
 
-        bar = tqdm(
-            total=cfg.epochs, desc="epochs", unit="ep", disable=args.no_progress, file=sys.stderr
-        )
+    def on_epoch(epoch: int, train: float, val: float) -> None:
+        bar.update(1)
+        bar.set_postfix(loss=f"{train:.4f}", val=f"{val:.4f}")
 
-        def on_epoch(epoch: int, train: float, val: float) -> None:
-            bar.update(1)
-            bar.set_postfix(loss=f"{train:.4f}", val=f"{val:.4f}")
-
-        result = train_bc(cfg, on_epoch)
-        bar.close()
-    except GymFGError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+    result = train_bc(cfg, on_epoch)
+    bar.close()
     print(
         f"trained {result.meta['name']} on {result.meta['train']['frames']} frames "
         f"({result.frames / result.seconds:,.0f} frames/s): loss {result.train_loss[0]:.4f} "

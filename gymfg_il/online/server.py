@@ -15,7 +15,7 @@ import hmac
 import logging
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.online.protocol import MAX_MESSAGE_BYTES, ProtocolError, decode, encode
@@ -50,31 +50,38 @@ class ServerConfig:
     """Settings of the central state server.
 
     Attributes:
-        mode: fixed (k teams) or open (any number, joining at step boundaries).
+        mode: fixed: k teams, starts when all joined, ends when one completes; open: teams
+            join and leave at step boundaries.
         teams: k, for the fixed mode.
-        bind: address to bind; loopback unless told otherwise.
+        bind: address to listen on; loopback unless told otherwise.
         port: TCP port (0 picks a free one).
         secrets: team -> secret; a team not listed needs ``shared_secret``.
-        shared_secret: one secret for every team ("" and no secrets = no authentication).
-        timeout_s: a team silent this long while others wait counts as stalled.
-        on_stall: drop the stalled team, pause the others, or end the simulation.
-        opponent_view: the state variables a team receives of other teams' aircraft.
-        curve: encrypt with ZeroMQ CURVE (clients need the printed server public key).
+        shared_secret: one secret every team must present ("" and no per-team secrets = no
+            authentication).
+        timeout_s: seconds of silence after which a team counts as stalled (while others
+            wait).
+        on_stall: what a stalled team does to the others: drop it (it may rejoin), pause the
+            others, or end the simulation.
+        opponent_view: the state variables teams see of each other's aircraft (position and
+            orientation by default).
+        curve: encrypt with ZeroMQ CURVE; prints the public key clients need.
         batch_io: run the server's ZeroMQ I/O thread under Linux's SCHED_BATCH policy, so
             that the replies of a tick are queued without the I/O thread preempting the
             server after the first one, and go out together when the server next waits
             (see ``gymfg_il.online.threads``). False keeps the default policy.
     """
 
-    mode: str = "fixed"
+    mode: Literal["fixed", "open"] = "fixed"
     teams: int = 2
     bind: str = "127.0.0.1"
     port: int = 5555
-    secrets: dict[str, str] = field(default_factory=dict)
-    shared_secret: str = ""
-    timeout_s: float = 5.0
-    on_stall: str = "drop"
-    opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW
+    secrets: dict[str, str] = field(default_factory=dict, metadata={"cli": False})
+    shared_secret: str = field(default="", metadata={"flag": "--secret"})
+    timeout_s: float = field(default=5.0, metadata={"flag": "--timeout"})
+    on_stall: Literal["drop", "pause", "end"] = "drop"
+    opponent_view: tuple[str, ...] = field(
+        default=DEFAULT_OPPONENT_VIEW, metadata={"flag": "--view"}
+    )
     curve: bool = False
     batch_io: bool = True
 
@@ -88,7 +95,8 @@ class ServerConfig:
             problems.append(f"on_stall={self.on_stall!r}: choose drop, pause or end")
         if not self.timeout_s > 0:
             problems.append(f"timeout_s={self.timeout_s} must be > 0")
-        indices(tuple(self.opponent_view))
+        self.opponent_view = tuple(self.opponent_view)
+        indices(self.opponent_view)
         if problems:
             raise ConfigError("server: " + "; ".join(problems))
 
