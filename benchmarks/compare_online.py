@@ -1,10 +1,11 @@
 """Online lockstep: this working tree against a git revision, in alternating runs.
 
-    python benchmarks/compare_online.py afae2c1 --rounds 6
+    python -m benchmarks.compare_online afae2c1 --rounds 6
 
-Each round runs ``benchmarks/run.py``'s ``online(teams, steps)`` once with the revision's
-code (checked out in a temporary git worktree) and once with this tree's, so that a slow
-spell of a shared machine hits both sides. Prints every pair, the medians and the best.
+Each round runs one lockstep (``benchmarks.online``, or ``benchmarks/run.py``'s ``online`` in
+revisions from before the benchmarks were split) with the revision's code (checked out in a
+temporary git worktree) and once with this tree's, so that a slow spell of a shared machine
+hits both sides. Prints every pair, the medians and the best.
 """
 
 from __future__ import annotations
@@ -21,19 +22,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def rate(tree: Path, teams: int, steps: int) -> float:
-    code = (
-        f"import sys; sys.path.insert(0, {str(tree / 'benchmarks')!r}); import run; "
-        f"print(run.online({teams}, {steps}))"
-    )
-    env = {**os.environ, "PYTHONPATH": str(tree)}  # the server and clients import this tree
-    out = subprocess.run(
-        [sys.executable, "-c", code],
-        env=env,
-        cwd=tempfile.gettempdir(),
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout
+    """One lockstep run with ``tree``'s code (its server and clients import that tree)."""
+    if (tree / "benchmarks" / "online.py").is_file():
+        cmd = [sys.executable, "-m", "benchmarks.online", "--rate", str(teams), str(steps)]
+    else:  # a revision from before the split: its run.py held online()
+        code = f"import run; print(run.online({teams}, {steps}))"
+        cmd = [sys.executable, "-c", code]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tree), str(tree / "benchmarks")])}
+    out = subprocess.run(cmd, env=env, cwd=tree, check=True, capture_output=True, text=True).stdout
     return float(out.split()[-1])
 
 

@@ -1,0 +1,205 @@
+"""The online lockstep: simulation steps/s of client processes (one c172p each, flown by its
+autopilot at 10 Hz) in lockstep with a real server on loopback.
+
+Two teams run in alternating rounds beside clients that sleep on every reply
+(``spin_us=0``), I/O threads at the default scheduling policy, clients pinned to a CPU each,
+and two teams that only report without simulating (the messaging's own ceiling); 8 and 16
+teams are one run each.
+
+    python -m benchmarks.online --client ADDRESS TEAM STEPS CPU SPIN_US BATCH_IO
+    python -m benchmarks.online --bare-client ADDRESS TEAM STEPS
+
+are the client processes it starts (they print ``RATE <steps/s>``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.common import Row
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def client(
+    address: str,
+    name: str,
+    steps: int,
+    cpu: int | None = None,
+    spin_us: float = 1000.0,
+    batch_io: bool = True,
+) -> None:
+    """One team of one c172p flying ``steps`` lockstep steps; prints its steps/s."""
+    from gymfg_il import Team
+    from gymfg_il.aircraft import c172p
+    from gymfg_il.controllers.autopilot import controller_for
+    from gymfg_il.online.client import OnlineEnv
+    from gymfg_il.tasks import LevelFlightTask
+
+    team = Team(name, [(c172p(f"{name}-1"), LevelFlightTask)], episode_time_s=steps / 10 + 10)
+    env = OnlineEnv(address, timeout_s=60, cpu=cpu, spin_us=spin_us, batch_io=batch_io)
+    (obs,), _ = env.reset(team, seed=0)
+    assert env.world is not None
+    slot = env.world.slots[0]
+    pilot = controller_for(slot.task, "c172p", env.dt, 0.75)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        (obs,), *_ = env.step(pilot.act(obs))
+    print(f"RATE {steps / (time.perf_counter() - t0)}", flush=True)
+    env.close()
+
+
+def bare_client(address: str, name: str, steps: int) -> None:
+    """The messaging alone: one team reporting a fixed state every step, no simulation,
+    sending and waiting as OnlineEnv does (batched I/O thread, polling)."""
+    import zmq
+
+    from gymfg_il.online.protocol import decode, encode
+    from gymfg_il.online.threads import first_socket
+    from gymfg_il.sim.properties import NAMES
+
+    sock = first_socket(zmq.Context(), zmq.DEALER, batch=True)
+    sock.connect(address)
+    sock.send(encode({"type": "join", "team": name, "token": "", "aircraft": {name: "c172p"}}))
+    decode(sock.recv(), "server")
+    report = encode(
+        {"type": "report", "team": name, "token": "", "states": {name: [0.5] * len(NAMES)}}
+    )
+
+    def recv() -> bytes:  # poll, yielding the CPU, for up to 1 ms
+        deadline = time.perf_counter() + 1e-3
+        while time.perf_counter() < deadline:
+            try:
+                return sock.recv(zmq.NOBLOCK)
+            except zmq.Again:
+                os.sched_yield()
+        return sock.recv()
+
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        sock.send(report)
+        os.sched_yield()
+        while decode(recv(), "server")["type"] != "central":
+            pass
+    print(f"RATE {steps / (time.perf_counter() - t0)}", flush=True)
+    sock.close(0)
+
+
+def online(
+    teams: int,
+    steps: int,
+    bare: bool = False,
+    pinned: bool = False,
+    spin_us: float = 1000.0,
+    batch_io: bool = True,
+) -> float:
+    """Simulation steps/s of ``teams`` client processes in lockstep with a real server
+    (``bare``: clients that only report, the messaging's own ceiling; ``pinned``: each
+    client on a CPU of its own, ``OnlineEnv(cpu=i)``; ``spin_us``: how long clients poll for
+    a reply before sleeping on it; ``batch_io``: the ZeroMQ I/O threads of server and
+    clients under SCHED_BATCH)."""
+    cpus = sorted(os.sched_getaffinity(0))
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    server = subprocess.Popen(
+        [
+            sys.executable, "-m", "gymfg_il.serve", "--mode", "fixed", "--teams", str(teams),
+            "--port", str(port), "--batch-io" if batch_io else "--no-batch-io",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        cwd=ROOT,
+        env=env,
+    )  # fmt: skip
+    try:
+        assert server.stdout is not None and b"serving" in server.stdout.readline()
+        address = f"tcp://127.0.0.1:{port}"
+        clients = []
+        for i in range(teams):
+            how = ["--bare-client"] if bare else ["--client"]
+            args = [address, f"team{i}", str(steps)]
+            if not bare:
+                cpu = cpus[i % len(cpus)] if pinned else -1
+                args += [str(cpu), str(spin_us), str(int(batch_io))]
+            cmd = [sys.executable, "-m", "benchmarks.online", *how, *args]
+            clients.append(subprocess.Popen(cmd, stdout=subprocess.PIPE, cwd=ROOT, env=env))
+        rates = []
+        for c in clients:
+            out = c.communicate(timeout=600)[0].decode()
+            rates += [float(x.split()[1]) for x in out.splitlines() if x.startswith("RATE")]
+        return min(rates)  # lockstep: the simulation runs at its slowest team's pace
+    finally:
+        server.terminate()
+        server.wait(10)
+
+
+def rows(quick: bool) -> list[Row]:
+    steps = 300 if quick else 2000
+    bare = online(2, 300 if quick else 3000, bare=True)
+    sides = {
+        "clients that sleep on every reply (spin_us=0)": {"spin_us": 0.0},
+        "ZeroMQ I/O threads at the default policy (batch_io off)": {"batch_io": False},
+        "each client on its own CPU (OnlineEnv(cpu=i))": {"pinned": True},
+        "default (clients poll up to 1 ms; I/O threads batched)": {},
+    }
+    runs: dict[str, list[float]] = {side: [] for side in sides}
+    for _ in range(1 if quick else 3):  # alternating rounds: a slow spell hits all sides
+        for side, options in sides.items():
+            runs[side].append(online(2, steps, **options))  # type: ignore[arg-type]
+    detail = [f"2 teams, messaging alone (no simulation) {bare:9,.0f} steps/s (ceiling)"]
+    detail += [
+        f"2 teams, {side}: best {max(r):7,.0f}, median {np.median(r):7,.0f} steps/s"
+        for side, r in runs.items()
+    ]
+    sleeping, unbatched, pinned, default = runs.values()
+    out = [
+        Row("online_2_teams_pinned_steps_per_s", max(pinned), "steps/s"),
+        Row(
+            "online_2_teams_steps_per_s",
+            max(default),
+            "steps/s",
+            2000,
+            detail=detail,
+            extra={
+                "median": float(np.median(default)),
+                "sleeping_clients": max(sleeping),
+                "io_threads_default_policy": max(unbatched),
+            },
+        ),
+    ]
+    for teams in (8, 16):
+        out.append(Row(f"online_{teams}_teams_steps_per_s", online(teams, steps), "steps/s"))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--client", nargs=6, metavar="ARG")
+    p.add_argument("--bare-client", nargs=3, metavar="ARG")
+    p.add_argument("--rate", nargs=2, type=int, metavar=("TEAMS", "STEPS"), help="one run")
+    args = p.parse_args(argv)
+    if args.client:
+        address, team, steps, cpu, spin, batch = args.client
+        client(
+            address, team, int(steps), int(cpu) if int(cpu) >= 0 else None, float(spin),
+            batch == "1",
+        )  # fmt: skip
+    elif args.bare_client:
+        bare_client(args.bare_client[0], args.bare_client[1], int(args.bare_client[2]))
+    elif args.rate:
+        print(online(*args.rate))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
