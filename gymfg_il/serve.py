@@ -45,8 +45,6 @@ def _serve(config: object, args: argparse.Namespace) -> int:
     assert isinstance(config, ServerConfig)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(message)s")
     server = StateServer(config)
-    if not (config.secrets or config.shared_secret):
-        logging.warning("no secrets given: any client may join as any team")
     print(f"serving {config.mode} simulation on {server.address}", flush=True)
     if server.public_key is not None:
         print(f"CURVE public key: {server.public_key.decode()}", flush=True)

@@ -10,6 +10,7 @@ others.
 
 from __future__ import annotations
 
+import logging
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -28,6 +29,7 @@ from gymfg_il.sim.properties import ORIENTATION, POSITION
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 
 _LEAVE_LINGER_MS = 250
+log = logging.getLogger(__name__)
 
 
 class OnlineEnv:
@@ -128,6 +130,7 @@ class OnlineEnv:
         self.joined = False
         self._rng = np.random.default_rng()
         self._done = True
+        self._waiting = ""  # the last reason the server gave for making the team wait
         self.opponents: list[str] = []
 
     @property
@@ -187,10 +190,19 @@ class OnlineEnv:
                 raise ServerError("malformed", f"the server sent a bad message: {err}") from None
             if reply["type"] == "error":
                 raise ServerError(reply.get("code", "error"), reply.get("message", ""))
-            if reply["type"] == "wait":
-                continue  # a paused simulation: keep waiting
+            if reply["type"] == "wait":  # a paused or not yet started simulation
+                reason = str(reply.get("reason", ""))
+                if reason != self._waiting:  # said once per reason, not once per second
+                    log.warning("%s: %s", self.address, reason)
+                    self._waiting = reason
+                continue
             if reply["type"] == expect:
                 return reply
+
+    def _join(self) -> dict[str, Any]:
+        assert self.team is not None
+        aircraft = {a.callsign: a.model for a in self.team.aircraft}
+        return self._request({"type": "join", "aircraft": aircraft}, "welcome")
 
     def _states(self) -> dict[str, list[float]]:
         assert self.world is not None
@@ -235,10 +247,7 @@ class OnlineEnv:
         if self.world is None or self.team is None:
             raise EnvStateError("the first reset needs your team: env.reset(team)")
         if not self.joined:
-            welcome = self._request(
-                {"type": "join", "aircraft": {a.callsign: a.model for a in self.team.aircraft}},
-                "welcome",
-            )
+            welcome = self._join()
             self.view = tuple(welcome["opponent_view"])
             if self.view != tuple(self.config.opponent_view):  # the server decides
                 for view in self.world.external.values():
@@ -252,7 +261,13 @@ class OnlineEnv:
             self._rng = np.random.default_rng(seed)
         overrides = dict((options or {}).get("initial_conditions", {}))
         self.world.reset(self._rng, overrides)
-        central = self._report(done=False)
+        try:
+            central = self._report(done=False)
+        except ServerError as err:
+            if err.code != "unknown":
+                raise
+            self._join()  # the server forgot the team (a new simulation, a long absence)
+            central = self._report(done=False)
         self._done = False
         opponents = self._opponents(central)
         return [self.world.observation(s) for s in self.world.slots], opponents
@@ -277,6 +292,8 @@ class OnlineEnv:
         finally:  # even when scoring fails, this tick's reply must not be left unread
             central = self._receive("central")
         opponents = self._opponents(central)
+        if central["done"]:  # the simulation ended: its roster is gone, join the next anew
+            self.joined = False
         if not early:
             observations, rewards, terminated, info = self._outcome()
         terminated = terminated or terminated_now

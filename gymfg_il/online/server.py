@@ -6,99 +6,61 @@ refused, it ends when one team completes) and ``open`` (teams join at any step b
 leave when they are done). The opponent restriction is applied here, so a client never
 receives more than the opponent view. A team that stops reporting for ``timeout_s`` is
 dropped (it may rejoin under its name and token), pauses the others, or ends the simulation,
-as configured. Malformed and oversized messages are refused with an error reply and logged.
+as configured. Malformed and oversized messages are refused with an error reply; the log says
+so in full a few times and then in one summary line per ten seconds, so a flood cannot flood
+the log. Who may join, and how many at once, is ``online.roster``'s business.
 """
 
 from __future__ import annotations
 
-import hmac
+import collections
 import logging
 import time
-from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.online.config import ServerConfig
 from gymfg_il.online.protocol import MAX_MESSAGE_BYTES, ProtocolError, decode, encode
+from gymfg_il.online.roster import Refused, Roster, TeamRecord
 from gymfg_il.online.threads import first_socket
-from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
+from gymfg_il.sim.properties import indices
 
+__all__ = ["ServerConfig", "StateServer"]
 log = logging.getLogger(__name__)
 
-MODES = ("fixed", "open")
-ON_STALL = ("drop", "pause", "end")
 
+class RefusalLog:
+    """Refused messages in the log: the first few of every ``window_s`` in full, the rest
+    counted and summarised in one line when the window closes."""
 
-@dataclass
-class TeamRecord:
-    name: str
-    identity: bytes
-    token: str
-    callsigns: list[str]
-    members: frozenset[str] = field(init=False)  # the callsigns, as a set
-    active: bool = False  # takes part in the lockstep
-    report: dict[str, list[float]] | None = None  # this tick's report
-    done: bool = False
-    last_seen: float = field(default_factory=time.monotonic)
-    states: dict[str, list[float]] = field(default_factory=dict)  # latest
+    def __init__(self, full: int = 5, window_s: float = 10.0) -> None:
+        self.full, self.window_s = full, window_s
+        self.start = time.monotonic()
+        self.logged = 0
+        self.quiet: collections.Counter[str] = collections.Counter()
 
-    def __post_init__(self) -> None:
-        self.members = frozenset(self.callsigns)
+    def refused(self, code: str, message: str) -> None:
+        self.flush()
+        if self.logged < self.full:
+            self.logged += 1
+            log.warning("refused a message (%s): %s", code, message)
+        else:
+            self.quiet[code] += 1
 
-
-@dataclass
-class ServerConfig:
-    """Settings of the central state server.
-
-    Attributes:
-        mode: fixed: k teams, starts when all joined, ends when one completes; open: teams
-            join and leave at step boundaries.
-        teams: k, for the fixed mode.
-        bind: address to listen on; loopback unless told otherwise.
-        port: TCP port (0 picks a free one).
-        secrets: team -> secret; a team not listed needs ``shared_secret``.
-        shared_secret: one secret every team must present ("" and no per-team secrets = no
-            authentication).
-        timeout_s: seconds of silence after which a team counts as stalled (while others
-            wait).
-        on_stall: what a stalled team does to the others: drop it (it may rejoin), pause the
-            others, or end the simulation.
-        opponent_view: the state variables teams see of each other's aircraft (position and
-            orientation by default).
-        curve: encrypt with ZeroMQ CURVE; prints the public key clients need.
-        batch_io: run the server's ZeroMQ I/O thread under Linux's SCHED_BATCH policy, so
-            that the replies of a tick are queued without the I/O thread preempting the
-            server after the first one, and go out together when the server next waits
-            (see ``gymfg_il.online.threads``). False keeps the default policy.
-    """
-
-    mode: Literal["fixed", "open"] = "fixed"
-    teams: int = 2
-    bind: str = "127.0.0.1"
-    port: int = 5555
-    secrets: dict[str, str] = field(default_factory=dict, metadata={"cli": False})
-    shared_secret: str = field(default="", metadata={"flag": "--secret"})
-    timeout_s: float = field(default=5.0, metadata={"flag": "--timeout"})
-    on_stall: Literal["drop", "pause", "end"] = "drop"
-    opponent_view: tuple[str, ...] = field(
-        default=DEFAULT_OPPONENT_VIEW, metadata={"flag": "--view"}
-    )
-    curve: bool = False
-    batch_io: bool = True
-
-    def __post_init__(self) -> None:
-        problems = []
-        if self.mode not in MODES:
-            problems.append(f"mode={self.mode!r}: choose fixed or open")
-        if self.mode == "fixed" and self.teams < 1:
-            problems.append(f"teams={self.teams}: a fixed simulation needs k >= 1")
-        if self.on_stall not in ON_STALL:
-            problems.append(f"on_stall={self.on_stall!r}: choose drop, pause or end")
-        if not self.timeout_s > 0:
-            problems.append(f"timeout_s={self.timeout_s} must be > 0")
-        self.opponent_view = tuple(self.opponent_view)
-        indices(self.opponent_view)
-        if problems:
-            raise ConfigError("server: " + "; ".join(problems))
+    def flush(self, now: float | None = None) -> None:
+        now = time.monotonic() if now is None else now
+        if now - self.start < self.window_s:
+            return
+        if self.quiet:
+            counts = ", ".join(f"{code}: {n}" for code, n in sorted(self.quiet.items()))
+            log.warning(
+                "refused %d more messages in the last %.0f s (%s)",
+                sum(self.quiet.values()),
+                now - self.start,
+                counts,
+            )
+        self.start, self.logged = now, 0
+        self.quiet.clear()
 
 
 class StateServer:
@@ -126,16 +88,37 @@ class StateServer:
             self.sock.curve_publickey = public
             self.sock.curve_server = True
             self.public_key = public
-        if config.port:
-            self.sock.bind(f"tcp://{config.bind}:{config.port}")
-            self.port = config.port
-        else:
-            self.port = self.sock.bind_to_random_port(f"tcp://{config.bind}")
+        try:
+            if config.port:
+                self.sock.bind(f"tcp://{config.bind}:{config.port}")
+                self.port = config.port
+            else:
+                self.port = self.sock.bind_to_random_port(f"tcp://{config.bind}")
+        except zmq.ZMQError as err:
+            self.close()
+            where = f"{config.bind}:{config.port or 'any port'}"
+            raise ConfigError(
+                f"cannot listen on {where} ({err}); is another server using the port, or "
+                "is the address not one of this machine's?"
+            ) from None
         self.view_idx = indices(tuple(config.opponent_view))
         self._view = self.view_idx.tolist()
         self._last_stall_check = 0.0
-        self.teams: dict[str, TeamRecord] = {}
-        self.owner: dict[str, str] = {}  # callsign -> team
+        self.roster = Roster(
+            config.secrets,
+            config.shared_secret,
+            config.max_teams,
+            config.teams if config.mode == "fixed" else None,
+            config.timeout_s,
+        )
+        self.teams = self.roster.teams  # name -> record (the roster's own dict)
+        self.refusals = RefusalLog()
+        if self.roster.open_to_all:
+            log.warning(
+                "no secrets given: any client that reaches %s may join as any team and read "
+                "every aircraft's position (give --secret or --team NAME:SECRET)",
+                config.bind,
+            )
         self.tick = 0
         self.simulation = 0
         self.running = False  # the lockstep has started
@@ -158,57 +141,17 @@ class StateServer:
 
     def _error(self, identity: bytes, code: str, message: str) -> None:
         self.refused += 1
-        log.warning("refused a message (%s): %s", code, message)
+        self.refusals.refused(code, message)
         self._send(identity, {"type": "error", "code": code, "message": message})
-
-    def _authorised(self, team: str, token: str) -> bool:
-        secret = self.config.secrets.get(team, self.config.shared_secret)
-        if not secret:
-            return True
-        return hmac.compare_digest(secret.encode(), str(token).encode())
 
     # -- requests ------------------------------------------------------------------------
     def _join(self, identity: bytes, msg: dict[str, Any]) -> None:
-        name, token = msg["team"], msg.get("token", "")
-        if not self._authorised(name, token):
-            self._error(identity, "unauthorised", f"team {name!r}: wrong or missing token")
+        name = msg["team"]
+        try:
+            self.roster.join(identity, name, msg.get("token", ""), list(msg["aircraft"]))
+        except Refused as refusal:
+            self._error(identity, refusal.code, str(refusal))
             return
-        callsigns = list(msg["aircraft"])
-        known = self.teams.get(name)
-        if known is not None:
-            if known.active and known.identity != identity:
-                self._error(
-                    identity,
-                    "duplicate",
-                    f"team {name!r} is already connected; team names are unique in a simulation",
-                )
-                return
-            if sorted(known.callsigns) != sorted(callsigns):
-                self._error(identity, "roster", f"team {name!r} rejoined with other aircraft")
-                return
-            known.identity, known.token = identity, token  # rejoin
-            known.report, known.done, known.last_seen = None, False, time.monotonic()
-        else:
-            if self.config.mode == "fixed" and len(self.teams) >= self.config.teams:
-                self._error(
-                    identity,
-                    "full",
-                    f"this simulation takes {self.config.teams} "
-                    "teams and has them all; try another server or wait for it to end",
-                )
-                return
-            taken = [c for c in callsigns if c in self.owner]
-            if taken:
-                self._error(
-                    identity,
-                    "duplicate",
-                    f"callsigns {taken} are taken by other "
-                    "teams; callsigns are unique in a simulation",
-                )
-                return
-            self.teams[name] = TeamRecord(name, identity, token, callsigns)
-            for c in callsigns:
-                self.owner[c] = name
         log.info("team %s joined (%d teams)", name, len(self.teams))
         self._send(
             identity,
@@ -231,7 +174,7 @@ class StateServer:
                 f"team {name!r} has not joined from this connection; send join first",
             )
             return
-        if not hmac.compare_digest(team.token.encode(), str(msg.get("token", "")).encode()):
+        if not self.roster.same_token(team, msg.get("token", "")):
             self._error(identity, "unauthorised", f"team {name!r}: wrong token")
             return
         states = msg["states"]
@@ -250,7 +193,7 @@ class StateServer:
         team.report, team.done = states, bool(msg.get("done", False))
         team.states = states
         team.last_seen = time.monotonic()
-        team.active = True  # (re)joins the lockstep at this step boundary
+        team.active = team.reported = True  # (re)joins the lockstep at this step boundary
         self._maybe_broadcast()
 
     def _leave(self, identity: bytes, msg: dict[str, Any]) -> None:
@@ -258,6 +201,11 @@ class StateServer:
         if team is not None and team.identity == identity:
             team.active, team.report, team.states = False, None, {}  # others stop seeing it
             log.info("team %s left", team.name)
+            if self.config.mode == "fixed" and not self.running:
+                self.roster.remove(team.name)  # its slot of the coming simulation is free
+            elif self.running and not any(t.active for t in self.teams.values()):
+                self._new_simulation("every team left")
+                return
             self._maybe_broadcast()
 
     # -- lockstep ------------------------------------------------------------------------
@@ -267,6 +215,7 @@ class StateServer:
             return
         if self.config.mode == "fixed" and not self.running:
             if len(active) < self.config.teams or any(t.report is None for t in active):
+                self._tell_waiting(active)
                 return  # waiting for all k teams
             self.running = True
         if any(t.report is None for t in active):
@@ -308,20 +257,44 @@ class StateServer:
         if end:
             self._new_simulation(reason)
 
+    def _tell_waiting(self, active: list[TeamRecord]) -> None:
+        """Tell the teams waiting for a k-fixed start what they wait for (a client's wait
+        clock restarts on it)."""
+        missing = self.config.teams - len(active)
+        reason = (
+            f"waiting for {missing} more team{'s' if missing != 1 else ''} to join"
+            if missing > 0
+            else "waiting for every team's first report"
+        )
+        for t in active:
+            if t.report is not None:
+                self._send(t.identity, {"type": "wait", "reason": reason})
+        self._paused_notice = time.monotonic()
+
     def _new_simulation(self, reason: str) -> None:
+        """End the simulation; the roster is cleared, so any teams may play the next one
+        (the clients of this one join again when they reset)."""
         log.info("simulation %d ended at tick %d: %s", self.simulation, self.tick, reason)
         self.simulation += 1
         self.tick = 0
         self.running = False
-        for team in self.teams.values():
-            team.active, team.report, team.done, team.states = False, None, False, {}
+        self.roster.clear()
 
     def _check_stalls(self) -> None:
+        now = time.monotonic()
+        self.refusals.flush(now)
+        for name in self.roster.free_unreported(now, self.config.timeout_s):
+            log.warning("freed the slot of team %s: it joined but never reported", name)
         active = [t for t in self.teams.values() if t.active]
         waiting = [t for t in active if t.report is not None]
-        if not waiting or (self.config.mode == "fixed" and not self.running):
+        if self.config.mode == "fixed" and not self.running:
+            if waiting and now - self._paused_notice > 1.0:
+                self._tell_waiting(active)
             return
-        now = time.monotonic()
+        if not waiting:
+            if self.running and not active:  # everyone left or was dropped: start afresh
+                self._new_simulation("every team left")
+            return
         stalled = [
             t for t in active if t.report is None and now - t.last_seen > self.config.timeout_s
         ]

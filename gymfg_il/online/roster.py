@@ -1,0 +1,170 @@
+"""Who is in an online simulation: the teams that joined, which callsigns they own, who may
+join at all (secrets), and how many may be there at once.
+
+Rules the server relies on:
+
+- Authentication: when any secret is configured (per team or shared), every team needs one:
+  a team that is not listed and has no shared secret to present is refused. Only a server
+  with no secret at all lets anyone in (it says so loudly and listens on loopback only
+  unless told otherwise; see ``StateServer``).
+- Bounds: at most ``max_teams`` records at once. When full, records of teams that are no
+  longer flying (left, dropped, finished) and have been silent for the stall timeout make
+  room, oldest first; otherwise the join is refused as full.
+- Freeing: a team that joined but never reported within the stall timeout gives its slot up;
+  the whole roster is cleared when a simulation ends, so a k-fixed server hosts one
+  simulation after another for any teams.
+"""
+
+from __future__ import annotations
+
+import hmac
+import time
+from dataclasses import dataclass, field
+
+
+class Refused(Exception):
+    """A request the server turns down; ``code`` goes back to the sender with the message."""
+
+    def __init__(self, code: str, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+@dataclass
+class TeamRecord:
+    name: str
+    identity: bytes
+    token: str
+    callsigns: list[str]
+    members: frozenset[str] = field(init=False)  # the callsigns, as a set
+    active: bool = False  # takes part in the lockstep
+    report: dict[str, list[float]] | None = None  # this tick's report
+    done: bool = False
+    reported: bool = False  # has reported at least once since it joined
+    last_seen: float = field(default_factory=time.monotonic)
+    states: dict[str, list[float]] = field(default_factory=dict)  # latest
+
+    def __post_init__(self) -> None:
+        self.members = frozenset(self.callsigns)
+
+
+class Roster:
+    """The team records of one server.
+
+    Args:
+        secrets: team -> secret.
+        shared_secret: the secret of every team not in ``secrets``.
+        max_teams: records at once (joined, flying, or waiting to rejoin).
+        fixed_teams: k, for a k-fixed simulation (None: open).
+        away_s: how long a team that is not flying keeps its record against newcomers when
+            the roster is full (the stall timeout).
+    """
+
+    def __init__(
+        self,
+        secrets: dict[str, str],
+        shared_secret: str,
+        max_teams: int,
+        fixed_teams: int | None = None,
+        away_s: float = 5.0,
+    ) -> None:
+        self.secrets, self.shared_secret = dict(secrets), shared_secret
+        self.max_teams, self.fixed_teams, self.away_s = max_teams, fixed_teams, away_s
+        self.teams: dict[str, TeamRecord] = {}
+        self.owner: dict[str, str] = {}  # callsign -> team
+
+    @property
+    def open_to_all(self) -> bool:
+        """No secret is configured: anyone may join as any team."""
+        return not (self.secrets or self.shared_secret)
+
+    def authorised(self, team: str, token: str) -> bool:
+        if self.open_to_all:
+            return True
+        secret = self.secrets.get(team) or self.shared_secret
+        return bool(secret) and hmac.compare_digest(secret.encode(), str(token).encode())
+
+    def same_token(self, team: TeamRecord, token: object) -> bool:
+        """Whether a message carries the token its team joined with."""
+        return hmac.compare_digest(team.token.encode(), str(token).encode())
+
+    def check_token(self, team: str, token: str) -> None:
+        if self.authorised(team, token):
+            return
+        if not (self.secrets.get(team) or self.shared_secret):
+            raise Refused(
+                "unauthorised",
+                f"team {team!r} is not on this server's list of teams; ask its operator for "
+                "a team secret",
+            )
+        raise Refused("unauthorised", f"team {team!r}: wrong or missing token")
+
+    def join(self, identity: bytes, name: str, token: str, callsigns: list[str]) -> TeamRecord:
+        """Admit (or readmit) a team; Refused says why not."""
+        self.check_token(name, token)
+        known = self.teams.get(name)
+        if known is not None:
+            if known.active and known.identity != identity:
+                raise Refused(
+                    "duplicate",
+                    f"team {name!r} is already connected; team names are unique in a simulation",
+                )
+            if sorted(known.callsigns) != sorted(callsigns):
+                raise Refused("roster", f"team {name!r} rejoined with other aircraft")
+            known.identity, known.token = identity, token  # rejoin
+            known.report, known.done, known.last_seen = None, False, time.monotonic()
+            return known
+        if self.fixed_teams is not None and len(self.teams) >= self.fixed_teams:
+            raise Refused(
+                "full",
+                f"this simulation takes {self.fixed_teams} teams and has them all; try another "
+                "server or wait for it to end",
+            )
+        if len(self.teams) >= self.max_teams and not self._make_room():
+            raise Refused(
+                "full",
+                f"this server holds {self.max_teams} teams at most and has them all; try again "
+                "later",
+            )
+        taken = [c for c in callsigns if c in self.owner]
+        if taken:
+            raise Refused(
+                "duplicate",
+                f"callsigns {taken} are taken by other teams; callsigns are unique in a simulation",
+            )
+        record = TeamRecord(name, identity, token, callsigns)
+        self.teams[name] = record
+        for c in callsigns:
+            self.owner[c] = name
+        return record
+
+    def _make_room(self) -> bool:
+        """Forget the team that has been away longest, if one has been away (not flying,
+        silent) for the stall timeout."""
+        now = time.monotonic()
+        away = [t for t in self.teams.values() if not t.active and now - t.last_seen > self.away_s]
+        if not away:
+            return False
+        self.remove(min(away, key=lambda t: t.last_seen).name)
+        return True
+
+    def remove(self, name: str) -> None:
+        team = self.teams.pop(name, None)
+        if team is not None:
+            for c in team.callsigns:
+                self.owner.pop(c, None)
+
+    def free_unreported(self, now: float, timeout_s: float) -> list[str]:
+        """Give up the slots of teams that joined but never reported within ``timeout_s``."""
+        gone = [
+            t.name
+            for t in self.teams.values()
+            if not t.reported and not t.active and now - t.last_seen > timeout_s
+        ]
+        for name in gone:
+            self.remove(name)
+        return gone
+
+    def clear(self) -> None:
+        self.teams.clear()
+        self.owner.clear()
