@@ -6,6 +6,7 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -137,7 +138,7 @@ def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve):
     address, proc, err = serve("--mode", "open", "--max-teams", "8", "--timeout", "2")
 
     def rss_kb():
-        status = open(f"/proc/{proc.pid}/status").read()
+        status = Path(f"/proc/{proc.pid}/status").read_text()
         return int(re.search(r"VmRSS:\s+(\d+)", status).group(1))
 
     before = rss_kb()
