@@ -111,15 +111,22 @@ def add_fields(
         if kind is bool:
             p.add_argument(flag, action=argparse.BooleanOptionalAction, **options)
         elif origin is typing.Literal:
-            p.add_argument(flag, choices=list(typing.get_args(kind)), **options)
+            choices = list(typing.get_args(kind))
+            p.add_argument(flag, choices=choices, type=type(choices[0]), **options)
         elif origin in (list, tuple):
-            # a repeatable flag gathers every use (--policy A --policy B); others take one list
+            # a repeatable flag gathers every use (--policy A --policy B); others take one list;
+            # a fixed-length tuple takes exactly its length
+            fixed = origin is tuple and Ellipsis not in args
+            nargs: int | str = len(args) if fixed else "+"
             action = "extend" if f.metadata.get("repeat") else "store"
-            p.add_argument(flag, nargs="+", type=args[0] if args else str, action=action, **options)
+            p.add_argument(
+                flag, nargs=nargs, type=args[0] if args else str, action=action, **options
+            )
         elif kind in (int, float, str, Path):
             p.add_argument(flag, type=kind, **options)
-        else:  # dict-valued and other structured fields come from recipes, not flags
-            continue
+        elif required:
+            raise TypeError(f"{cls.__name__}.{f.name}: a required field no flag can give")
+        # dict-valued and other structured fields come from recipes, not flags
 
 
 def build(cls: type, ns: argparse.Namespace, **extra: Any) -> Any:

@@ -22,6 +22,7 @@ EPILOG = __doc__.split("\n\n", 1)[1]
 FLIGHT = ("aircraft", "task", "dynamic", "episode_time_s", "seed")
 AUTOPILOT = (*FLIGHT, "episodes", "agent_hz", "noise", "out")
 MANUAL = (*FLIGHT, "device", "agent_hz", "episodes", "assist", "out", "view")
+RECIPE = tuple(dict.fromkeys(AUTOPILOT + MANUAL))
 
 
 def _workers(text: str) -> int:
@@ -54,7 +55,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
             "Run a collection recipe (collectors/*.toml); options override the recipe.",
         )
         r.add_argument("recipe", type=Path)
-        cli.add_fields(r, CollectConfig, only=AUTOPILOT, overrides_only=True)
+        cli.add_fields(r, CollectConfig, only=RECIPE, overrides_only=True)
+        r.add_argument(
+            "--fps", dest="agent_hz", type=int, default=cli.SUPPRESS, help="the same as --agent-hz"
+        )
         _running(r)
         args = r.parse_args(argv)
         args.command = "recipe"
@@ -116,12 +120,19 @@ def _autopilot(args: argparse.Namespace) -> int:
     from gymfg_il.collectors.autopilot import collect_autopilot
     from gymfg_il.collectors.commands import report_build
     from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.errors import ConfigError
 
     if args.command == "recipe":
-        options = {k: v for k, v in vars(args).items() if k in AUTOPILOT}
+        options = {k: v for k, v in vars(args).items() if k in RECIPE}
         cfg = CollectConfig.from_recipe(args.recipe, **options)
         if cfg.kind == "manual":
+            if "noise" in options or args.workers != 1:
+                raise ConfigError("--noise and --workers apply to autopilot recipes, not manual")
             return _fly_by_hand(cfg)
+        manual_only = sorted(set(options) & (set(MANUAL) - set(AUTOPILOT)))
+        if manual_only:
+            flags = ", ".join("--" + k.replace("_", "-") for k in manual_only)
+            raise ConfigError(f"{flags} apply to manual recipes; {args.recipe} is an autopilot one")
     else:
         cfg = cli.build(CollectConfig, args)
     show = not args.no_progress

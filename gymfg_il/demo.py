@@ -42,6 +42,18 @@ class DemoConfig:
     runs: Path = Path("runs")
     progress: bool = True
 
+    def __post_init__(self) -> None:
+        from gymfg_il.errors import ConfigError
+
+        bad = [
+            f"{k}={getattr(self, k)!r}"
+            for k in ("epochs", "episodes", "workers")
+            if isinstance(getattr(self, k), bool) or not isinstance(getattr(self, k), int)
+            or getattr(self, k) < 1
+        ]  # fmt: skip
+        if bad:
+            raise ConfigError(f"demo: {', '.join(bad)} must be integers >= 1")
+
 
 def main(argv: list[str] | None = None) -> int:
     from gymfg_il import cli

@@ -2,6 +2,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 from gymfg_il import eval as evaluate
 
 
@@ -110,3 +112,39 @@ def test_a_policy_flies_at_its_own_rate_and_the_rows_say_so(tmp_path, capsys):
     assert evaluate.main([*args, "--aircraft", "f15", "--json", str(rows_json)]) == 0
     assert "aircraft='f15'" in capsys.readouterr().err
     assert {r["aircraft"] for r in json.loads(rows_json.read_text())["rows"]} == {"f15"}
+
+
+def test_a_policy_without_a_single_flight_still_flies_at_its_datasets_rate():
+    from pathlib import Path
+
+    from gymfg_il.errors import ConfigError
+    from gymfg_il.evaluation.plots import primary_control
+    from gymfg_il.evaluation.runner import flight_for
+
+    meta = {"spec": None, "fps": 30, "spec_note": "its episodes were flown in 2 flights"}
+    with pytest.raises(ConfigError, match=r"2 flights.*--task and --aircraft"):
+        flight_for({Path("p"): meta})
+    flight, _ = flight_for({Path("p"): meta}, task="roll", aircraft="f15")
+    assert (flight.agent_hz, flight.task, flight.aircraft) == (30, "roll", "f15")
+    with pytest.raises(ConfigError, match=r"trained at \[30\] Hz"):
+        flight_for({Path("p"): meta}, task="roll", aircraft="f15", agent_hz=10)
+    assert primary_control("beta_deg") == 2 and primary_control("my_own_variable") == 1
+
+
+def test_a_dataset_whose_episodes_differ_only_in_length_keeps_its_flight():
+    import numpy as np
+
+    from gymfg_il.envs import FlightSpec
+    from gymfg_il.learning.data import Frames
+
+    short, long = (FlightSpec.solo(task="roll", episode_time_s=t) for t in (20, 60))
+    frames = Frames(
+        obs=np.zeros((2, 1), np.float32), action=np.zeros((2, 4), np.float32),
+        episode=np.arange(2), frame=np.zeros(2, np.int64), observation_names=["x"],
+        action_names=list("abcd"), fps=10, obs_stats={}, action_stats={},
+        episodes={"gymfg/spec": [short.to_json(), long.to_json()], "gymfg/callsign": ["ego"] * 2},
+    )  # fmt: skip
+    assert frames.flight() == (long, "")
+    frames.episodes["gymfg/spec"][0] = FlightSpec.solo(task="roll", agent_hz=20).to_json()
+    flight, why = frames.flight()
+    assert flight is None and "2 different flights" in why

@@ -65,11 +65,14 @@ def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
     if not paths:
         raise ConfigError(f"no logs under {target}")
     failures = 0
-    for path in paths:
-        log = read_log(path)
+    logs = [read_log(path) for path in paths]
+    if episode is not None and not any(
+        e.index == episode for lg in logs for e in lg.complete_episodes
+    ):
+        raise ConfigError(f"no log under {target} has a completed episode {episode}")
+    for log in logs:
+        path = log.path
         chosen = [e for e in log.complete_episodes if episode is None or e.index == episode]
-        if episode is not None and not chosen:
-            raise ConfigError(f"{path.name} has no completed episode {episode}")
         for ep in chosen:
             world = world_for(log, views) if views else None
             try:

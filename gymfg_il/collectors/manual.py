@@ -22,6 +22,7 @@ import numpy as np
 from gymfg_il.collectors.session import DATASET, check_appendable, check_out_folder
 from gymfg_il.collectors.updater import DatasetUpdater
 from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.errors import ConfigError
 from gymfg_il.manual.bindings import (
     JoystickBindings,
     KeyboardBindings,
@@ -62,6 +63,17 @@ SHOWN = (
     "beta_deg",
     "thrust_lbs",
 )
+
+
+def _check_assist_rate(meta: dict[str, Any], flight: FlightSpec, path: Path) -> None:
+    """A policy assists only at the rate it was trained at."""
+    rate = int((meta.get("spec") or {}).get("agent_hz") or meta.get("fps") or flight.agent_hz)
+    if rate != flight.agent_hz:
+        raise ConfigError(
+            f"the assisting policy {path} was trained at {rate} Hz and this session flies at "
+            f"{flight.agent_hz} Hz; fly the session at {rate} Hz (--fps {rate}) or use a policy "
+            "trained at this rate"
+        )
 
 
 def help_lines(device: str, kb: KeyboardBindings) -> list[str]:
@@ -151,6 +163,8 @@ class ManualSession:
             spec = (
                 AgentSpec.controller() if assist == "controller" else AgentSpec.policy(Path(assist))
             )
+            if spec.path is not None:
+                _check_assist_rate(spec.meta(), flight, spec.path)
             assistant = spec.make(self.env)
         self.pilot = Takeover(self.human, assistant)
         self.rollout = Rollout(self.env, [self.pilot])

@@ -7,6 +7,7 @@ process as results arrive in seed order, so it is identical to a one-worker sess
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +25,7 @@ from gymfg_il.rollout.seeded import iter_many
 from gymfg_il.workers import Workers
 
 DATASET = "dataset"
+log = logging.getLogger(__name__)
 
 __all__ = ["DATASET", "LOGS", "SessionResult", "check_appendable", "check_out_folder",
            "record_session"]  # fmt: skip
@@ -48,8 +50,11 @@ def check_out_folder(out: Path) -> None:
             )
 
 
-def check_appendable(out: Path, observation_names: Sequence[str], fps: int) -> None:
-    """Refuse, before flying anything, to collect data the existing dataset cannot take."""
+def check_appendable(
+    out: Path, observation_names: Sequence[str], fps: int, flight: FlightSpec | None = None
+) -> None:
+    """Refuse, before flying anything, to collect data the existing dataset cannot take; warn
+    when it holds another flight (a policy trained on both has no single flight to fly)."""
     root = out / DATASET
     if not (root / "meta" / "info.json").is_file():
         return
@@ -57,6 +62,17 @@ def check_appendable(out: Path, observation_names: Sequence[str], fps: int) -> N
     check_compatible(meta.features, dataset_features(observation_names), str(root))
     if meta.fps != fps:
         raise ConfigError(f"the dataset at {root} is at {meta.fps} fps, not {fps}")
+    episodes = meta.episodes
+    if flight is None or episodes is None or "gymfg/spec" not in episodes.column_names:
+        return
+    mine = flight.replace(episode_time_s=1.0)  # episode times may differ
+    theirs = {FlightSpec.from_json(s).replace(episode_time_s=1.0) for s in episodes["gymfg/spec"]}
+    if theirs - {mine}:
+        log.warning(
+            "the dataset at %s holds episodes of another flight (aircraft, task, options or "
+            "rate); a policy trained on it will record no single flight to be flown at",
+            root,
+        )
 
 
 @dataclass
@@ -89,7 +105,8 @@ def record_session(
     ``out/logs``; ``progress(i, return)`` is called once each episode is durable."""
     check_out_folder(out)
     record = session_record(flight, source, noise=noise, iteration=iteration)
-    check_appendable(out, record["aircraft"]["ego"]["observation_names"], flight.agent_hz)
+    names = record["aircraft"]["ego"]["observation_names"]
+    check_appendable(out, names, flight.agent_hz, flight)
     episodes: list[Episode] = []
     flown = iter_many(flight, pilot, seeds, workers, expert=expert, noise=noise)
     with TrajectoryWriter(new_log_path(out, source), record) as writer:

@@ -21,13 +21,14 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from gymfg_il.aircraft import Aircraft
 from gymfg_il.envs.config import EnvConfig
-from gymfg_il.envs.roster import UNBUILDABLE, AircraftSpec, TeamSpec, plain, unbuildable
+from gymfg_il.envs.roster import AircraftSpec, TeamSpec, plain, unbuildable
 from gymfg_il.envs.scenarios import Scenario, scenario_from_record, scenario_record
 from gymfg_il.envs.team import Team
 from gymfg_il.errors import ConfigError, GymFGError, join_problems
@@ -71,9 +72,12 @@ class FlightSpec:
     def __post_init__(self) -> None:
         problems: list[str] = []
         errors: list[GymFGError] = []
+        t = self.episode_time_s
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
+            problems.append(f"episode_time_s={t!r} must be a positive number of seconds")
         for check in (
             lambda: substeps(self.sim_hz, self.agent_hz),
-            lambda: episode_steps(self.episode_time_s, self.agent_hz),
+            lambda: not problems and episode_steps(self.episode_time_s, self.agent_hz),
             lambda: indices(tuple(self.opponent_view)),
         ):
             try:
@@ -83,6 +87,11 @@ class FlightSpec:
                 problems.append(str(err))
         object.__setattr__(self, "opponent_view", tuple(self.opponent_view))
         object.__setattr__(self, "teams", tuple(self.teams))
+        if self.scenario is not None:
+            object.__setattr__(self, "scenario", plain(dict(self.scenario)))
+        view = self.opponent_view
+        if len(set(view)) != len(view):
+            problems.append(f"opponent_view lists a variable twice: {view}")
         if not self.teams:
             problems.append("a flight needs at least one team")
         names = [t.name for t in self.teams]
@@ -187,7 +196,7 @@ class FlightSpec:
             "sim_hz": self.sim_hz,
             "episode_time_s": self.episode_time_s,
             "opponent_view": list(self.opponent_view),
-            "scenario": None if self.scenario is None else plain(dict(self.scenario)),
+            "scenario": self.scenario,
         }
 
     def to_json(self) -> str:
@@ -196,6 +205,15 @@ class FlightSpec:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> FlightSpec:
         """The spec a ``to_dict`` record describes; a clear error for anything else."""
+        try:
+            return cls._from_dict(data)
+        except (TypeError, ValueError, AttributeError) as err:
+            if isinstance(err, GymFGError):
+                raise
+            raise ConfigError(f"flight spec record is malformed ({err})") from None
+
+    @classmethod
+    def _from_dict(cls, data: Mapping[str, Any]) -> FlightSpec:
         if not isinstance(data, Mapping) or "teams" not in data:
             raise ConfigError(f"not a flight spec record (no 'teams'): {str(data)[:200]}")
         version = data.get("version", SPEC_VERSION)
@@ -272,10 +290,20 @@ class FlightSpec:
                 task_class(a.task, a.dynamic)
             except ConfigError as err:
                 problems.append(f"{a.callsign}: {err}")
-        name = (self.scenario or {}).get("name", "")
-        if str(name).startswith(UNBUILDABLE):
-            problems.append(f"scenario {name}")
+        if self.scenario is not None:
+            try:
+                scenario_from_record(self.scenario)
+            except ConfigError as err:
+                problems.append(f"scenario: {err}")
         return problems
+
+    def external_callsigns(self) -> list[str]:
+        """Reward targets outside this flight: aircraft an online team sees from the server."""
+        inside = {a.callsign for a in self.aircraft_specs}
+        return sorted(
+            {c for t in self.teams for found in t.reward_targets.values() for c, _ in found}
+            - inside
+        )
 
     # -- building ------------------------------------------------------------------------
     def build_teams(self) -> list[Team]:
@@ -320,7 +348,8 @@ class FlightSpec:
         from gymfg_il.envs.world import World
 
         config = self.env_config(scenario=scenario)
-        return World(teams or self.build_teams(), config, pool, external_targets)
+        external = external_targets or bool(self.external_callsigns())
+        return World(teams or self.build_teams(), config, pool, external)
 
     def make_env(self, views: list[int] | None = None) -> AircraftEnv:
         """The gymnasium env of a solo flight."""

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
+import json
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -20,19 +20,35 @@ from gymfg_il.tasks.library import TASK_FAMILIES, task_class
 UNBUILDABLE = "python:"  # marks a recorded value that cannot be rebuilt from the record
 
 
+class FrozenDict(dict[str, Any]):
+    """A dict a flight spec holds: it cannot be changed in place (``FlightSpec.replace``
+    makes a changed copy), it hashes by content, and it pickles and JSON-encodes as a dict."""
+
+    def _readonly(self, *args: object, **kwargs: object) -> None:
+        raise TypeError("a flight spec cannot be changed in place; use FlightSpec.replace")
+
+    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = _readonly  # type: ignore[assignment]
+    __ior__ = _readonly  # type: ignore[assignment]
+
+    def __hash__(self) -> int:  # type: ignore[override]
+        return hash(json.dumps(self, sort_keys=True, default=str))
+
+    def __reduce__(self) -> tuple[type, tuple[dict[str, Any]]]:
+        return (FrozenDict, (dict(self),))
+
+
 def plain(value: Any) -> Any:
-    """A task option as JSON-able data (``InitialConditions`` as a tagged dict; anything that
-    is not data, such as a reward function, as ``"python:<name>"``)."""
-    if value is None or isinstance(value, (bool, int, str)):
+    """A task option as immutable JSON-able data: sequences as tuples, mappings as
+    ``FrozenDict``, ``InitialConditions`` as a tagged mapping, and anything that is not data
+    (a reward function) as ``"python:<name>"``."""
+    if value is None or isinstance(value, (bool, int, float, str)):
         return value
-    if isinstance(value, float):
-        return value if math.isfinite(value) else str(value)
     if isinstance(value, InitialConditions):
-        return {"initial_conditions": dataclasses.asdict(value)}
+        return FrozenDict(initial_conditions=FrozenDict(dataclasses.asdict(value)))
     if isinstance(value, (list, tuple)):
-        return [plain(v) for v in value]
+        return tuple(plain(v) for v in value)
     if isinstance(value, Mapping):
-        return {str(k): plain(v) for k, v in value.items()}
+        return FrozenDict({str(k): plain(v) for k, v in value.items()})
     if hasattr(value, "item") and callable(value.item):  # a numpy scalar
         return plain(value.item())
     name = getattr(value, "__qualname__", type(value).__qualname__)
@@ -40,13 +56,13 @@ def plain(value: Any) -> Any:
 
 
 def live(value: Any) -> Any:
-    """The inverse of ``plain`` for what can be rebuilt."""
+    """The inverse of ``plain`` for what can be rebuilt (plain dicts, tuples, objects)."""
     if isinstance(value, Mapping):
         if set(value) == {"initial_conditions"}:
             return InitialConditions(**value["initial_conditions"])
         return {k: live(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [live(v) for v in value]
+    if isinstance(value, (list, tuple)):
+        return tuple(live(v) for v in value)
     return value
 
 
@@ -55,7 +71,7 @@ def unbuildable(value: Any) -> list[str]:
         return [value] if value.startswith(UNBUILDABLE) else []
     if isinstance(value, Mapping):
         return [u for v in value.values() for u in unbuildable(v)]
-    if isinstance(value, list):
+    if isinstance(value, (list, tuple)):
         return [u for v in value for u in unbuildable(v)]
     return []
 
@@ -112,7 +128,7 @@ class AircraftSpec:
             "callsign": self.callsign,
             "task": self.task,
             "dynamic": self.dynamic,
-            "task_kwargs": dict(self.task_kwargs),
+            "task_kwargs": self.task_kwargs,
         }
 
 
@@ -124,6 +140,24 @@ class TeamSpec:
     name: str
     roster: tuple[AircraftSpec, ...]
     reward_targets: Mapping[str, tuple[tuple[str, str], ...]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise ConfigError(f"a team name must be a non-empty string, got {self.name!r}")
+        object.__setattr__(self, "roster", tuple(self.roster))
+        if not all(isinstance(a, AircraftSpec) for a in self.roster):
+            raise ConfigError(f"team {self.name!r}: its roster must hold AircraftSpec entries")
+        targets = {
+            str(owner): tuple((str(c), str(m)) for c, m in found)
+            for owner, found in dict(self.reward_targets).items()
+        }
+        object.__setattr__(self, "reward_targets", FrozenDict(targets))
+        members = {a.callsign for a in self.roster}
+        strangers = sorted(set(targets) - members)
+        if strangers:
+            raise ConfigError(
+                f"team {self.name!r}: reward_targets name {strangers}, which are not in its roster"
+            )
 
     def to_dict(self) -> dict[str, Any]:
         return {

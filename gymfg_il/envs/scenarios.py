@@ -170,7 +170,8 @@ def scenario_from_record(record: Mapping[str, Any] | None) -> Scenario | None:
     unknown = sorted(set(params) - known)
     if unknown:
         raise ConfigError(f"scenario {name!r} has no parameters {unknown}; known: {sorted(known)}")
-    if isinstance(params.get("lead"), Mapping):
-        params["lead"] = InitialConditions(**params["lead"])
+    lead = params.get("lead")
+    if isinstance(lead, Mapping):  # recorded by asdict, or by a flight spec's plain form
+        params["lead"] = InitialConditions(**lead.get("initial_conditions", lead))
     scenario: Scenario = cls(**params)
     return scenario

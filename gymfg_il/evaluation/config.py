@@ -108,8 +108,11 @@ def plan(cfg: EvalConfig) -> tuple[FlightSpec, dict[str, AgentSpec], list[str]]:
     finally:
         env.close()
     agents = {"controller": AgentSpec.controller()}
-    for path in cfg.policy:
-        agents[f"policy:{path.name}"] = AgentSpec.policy(path)
+    names = [p.name for p in cfg.policy]
+    for path in cfg.policy:  # a folder name twice (run1/policy, run2/policy): the whole path
+        agents[f"policy:{path.name if names.count(path.name) == 1 else path}"] = AgentSpec.policy(
+            path
+        )
     return flight, agents, notes
 
 
@@ -131,12 +134,13 @@ def run_eval(
         cfg.json.write_text(json.dumps({"rows": rows}, indent=2))
         run.written.append(cfg.json)
     if cfg.plots:
-        from gymfg_il.evaluation.plots import PRIMARY_CONTROL, figure1
+        from gymfg_il.evaluation.plots import figure1, primary_control
 
-        label, model = flight.task_label, flight.aircraft
+        label, model = flight.task_label.rsplit(":", 1)[-1], flight.aircraft
         for name, episodes in traces.items():
             path = cfg.plots / f"{label}_{model}_{name.replace(':', '-')}.png"
             title = f"{name}: {label} on {model}"
-            figure1(episodes[: cfg.plot_episodes], PRIMARY_CONTROL[flight.task], title, path)
+            control = primary_control(episodes[0].variable)
+            figure1(episodes[: cfg.plot_episodes], control, title, path)
             run.written.append(path)
     return run

@@ -9,8 +9,21 @@ from pathlib import Path
 from gymfg_il.evaluation.trace import Trace
 from gymfg_il.sim.properties import ACTION_NAMES
 
-# The surface that mainly drives each family (the paper's Figure 1 "control signal" column).
-PRIMARY_CONTROL = {"altitude": 1, "pitch": 1, "level": 1, "roll": 0, "heading": 0, "airspeed": 3}
+# The surface that mainly drives each controlled variable (Figure 1's "control signal").
+PRIMARY_CONTROL = {
+    "altitude_ft": 1,
+    "pitch_deg": 1,
+    "roll_deg": 0,
+    "heading_deg": 0,
+    "airspeed_kts": 3,
+    "beta_deg": 2,
+}
+
+
+def primary_control(variable: str) -> int:
+    """The surface drawn for ``variable`` (the elevator for a variable not listed)."""
+    return PRIMARY_CONTROL.get(variable, 1)
+
 
 UNITS = {
     "altitude_ft": "ft",

@@ -17,6 +17,7 @@ from gymfg_il.evaluation.metrics import summarize
 from gymfg_il.evaluation.trace import Trace, trace_of
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.seeded import fly_many
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ
 from gymfg_il.workers import Workers
 
 # flag -> the solo spec field it sets
@@ -54,13 +55,22 @@ def flight_for(
     asked["episode_time_s"] = episode_time_s
     notes: list[str] = []
     if not known:
+        missing = ", ".join(str(p) for p in policies)
         if policies and (task is None or aircraft is None):
-            missing = ", ".join(str(p) for p in policies)
+            why = "; ".join(str(m.get("spec_note") or "") for m in policies.values()).strip("; ")
             raise ConfigError(
-                f"{missing} records no flight spec (trained before gymfg-il 0.2): give --task "
-                "and --aircraft (and --agent-hz if not 10)"
+                f"{missing} records no flight of its own ({why or 'its dataset predates them'})"
+                ": give --task and --aircraft"
             )
-        base = FlightSpec.solo(agent_hz=agent_hz or 10)
+        rates = {int(m["fps"]) for m in policies.values() if m.get("fps")}
+        if len(rates) > 1 or (rates and agent_hz is not None and {agent_hz} != rates):
+            raise ConfigError(
+                f"{missing} {'were' if len(policies) > 1 else 'was'} trained at {sorted(rates)} "
+                f"Hz (the dataset's fps) and fly at that rate; drop --agent-hz or evaluate "
+                "them separately"
+            )
+        rate = agent_hz or (rates.pop() if rates else DEFAULT_AGENT_HZ)
+        base = FlightSpec.solo(agent_hz=rate)
         return base.replace(**{k: v for k, v in asked.items() if v is not None}), notes
     path, base = next(iter(known.items()))
     if agent_hz is not None and agent_hz != base.agent_hz:

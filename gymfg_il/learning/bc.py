@@ -147,6 +147,7 @@ def train_bc(
         "name": name,
         # what the policy flies: the whole spec, and its names for a reader of the file
         "spec": flight.to_dict() if flight else None,
+        "spec_note": why,
         "task": flight.task if flight else None,
         "dynamic": flight.dynamic if flight else False,
         "aircraft": flight.aircraft if flight else None,

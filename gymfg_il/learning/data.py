@@ -38,19 +38,25 @@ class Frames:
         return len(self.action)
 
     def flight(self) -> tuple[FlightSpec | None, str]:
-        """The solo flight every episode was flown as (a team run's aircraft on its own), and
-        why there is none when the episodes disagree or predate flight specs."""
+        """The solo flight every episode was flown as (a team run's aircraft on its own; the
+        longest episode time where only that differs), and why there is none when the
+        episodes disagree on more or predate flight specs."""
         specs = self.episodes.get("gymfg/spec")
         if not specs:
-            return None, "its episodes record no flight spec (made before gymfg-il 0.2)"
+            return None, "its episodes record no flight spec (its dataset predates them)"
         callsigns = self.episodes.get("gymfg/callsign") or ["ego"] * len(specs)
         found = {
-            FlightSpec.from_json(text).for_callsign(c).to_json()
+            FlightSpec.from_json(text).for_callsign(c)
             for text, c in set(zip(specs, callsigns, strict=True))
         }
-        if len(found) > 1:
-            return None, f"its episodes were flown with {len(found)} different flight specs"
-        return FlightSpec.from_json(found.pop()), ""
+        longest = max(s.episode_time_s for s in found)
+        alike = {s.replace(episode_time_s=longest) for s in found}
+        if len(alike) > 1:
+            return None, (
+                f"its episodes were flown in {len(alike)} different flights (aircraft, task, "
+                "options or rate)"
+            )
+        return alike.pop(), ""
 
     def select(self, episodes: np.ndarray) -> Frames:
         keep = np.isin(self.episode, episodes)

@@ -26,9 +26,18 @@ from gymfg_il.errors import EnvStateError
 from gymfg_il.recording.session import session_record
 from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.loop import observe_live, starts, step_records, team_views
-from gymfg_il.rollout.records import Tick
+from gymfg_il.rollout.records import Step, Tick, reset_record
 
 LOGS = "logs"
+
+
+def _outcome(truncated: bool, records: list[Step], info: dict[str, Any]) -> str:
+    """As ``Episode.outcome`` says it: the time limit (or the server's reason for ending the
+    simulation), or why the last aircraft stopped."""
+    if truncated:
+        return str(info.get("server_reason") or "time limit")
+    reasons = [s.reason for s in records if s.reason]
+    return reasons[-1] if reasons else "terminated"
 
 
 def new_log_path(out: Path, tag: str = "session") -> Path:
@@ -83,13 +92,16 @@ class Recorder:
             self.writer.discard_episode("reset before the episode ended")
         if seed is None:
             seed = int(np.random.default_rng().integers(2**31))
-        if isinstance(self.env, AircraftEnv):
+        solo = isinstance(self.env, AircraftEnv)
+        if solo:
             out = self.env.reset(seed=seed, **kwargs)
         else:
             out = self.env.reset(*args, seed=seed, **kwargs)
             self._team = self.env.team
         writer = self._open()
-        writer.start_episode(seed, starts(self.env.world), source=self.source)
+        world = self.env.world
+        options = reset_record(kwargs.get("options"), world.slots[0].callsign if solo else None)
+        writer.start_episode(seed, starts(world), options, source=self.source)
         self._done = False
         return out
 
@@ -100,7 +112,7 @@ class Recorder:
         before = observe_live(world)
         out = self.env.step(action)
         if isinstance(self.env, AircraftEnv):
-            _, _, terminated, truncated, _ = out
+            _, _, terminated, truncated, info = out
             views = {}
         else:
             _, opponents, _, terminated, truncated, info = out
@@ -108,11 +120,14 @@ class Recorder:
             own = (self._team.name, info.get("opponent_callsigns", []), opponents)
             views = team_views(world, names, own)
         done = bool(terminated or truncated)
-        tick = Tick(world.steps, step_records(world, before, {}, {}, bool(truncated)), views, done)
-        self.writer.log_tick(tick)
+        records = step_records(world, before, {}, {}, done)
+        self.writer.log_tick(Tick(world.steps, records, views, done, bool(truncated)))
         if done:
-            outcome = "time limit" if truncated else "terminated"
-            self.writer.end_episode(outcome=outcome, steps=world.steps, interventions=0)
+            self.writer.end_episode(
+                outcome=_outcome(bool(truncated), records, info),
+                steps=world.steps,
+                interventions=0,
+            )
             self._done = True
         return out
 

@@ -16,11 +16,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gymfg_il.envs.actions import Controls
+from gymfg_il.envs.roster import live
 from gymfg_il.envs.scenarios import Scenario
 from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import World
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import Log, LoggedEpisode
+from gymfg_il.rollout.records import OpponentView
 
 
 @dataclass
@@ -62,6 +64,33 @@ def world_for(
     return World(teams or spec.build_teams(), config, external_targets=online)
 
 
+def _reset(world: World, episode: LoggedEpisode) -> None:
+    """Reset ``world`` as the episode was: its seed and the reset options it logged."""
+    options = episode.start.get("options") or {}
+    overrides = {c: live(ic) for c, ic in options.get("initial_conditions", {}).items()}
+    rng = np.random.default_rng(int(episode.start["seed"]))
+    target = options.get("target")
+    if target is None:
+        world.reset(rng, overrides)
+        return
+    task = world.slots[0].task  # a gymnasium env's fixed target for one episode
+    saved, task.fixed_target = task.fixed_target, float(target)  # type: ignore[attr-defined]
+    try:
+        world.reset(rng, overrides)
+    finally:
+        task.fixed_target = saved  # type: ignore[attr-defined]
+
+
+def _show(world: World, view: OpponentView) -> None:
+    """Give the world's external reward targets the values a logged view holds."""
+    for callsign, values in zip(view.callsigns, view.values, strict=True):
+        target = world.external.get(callsign)
+        if target is not None:
+            if target.names() != view.names:
+                target.rename(view.names)
+            target.values = values
+
+
 def replay_episode(
     log: Log,
     episode: LoggedEpisode,
@@ -69,9 +98,9 @@ def replay_episode(
     world: World | None = None,
     on_step: Callable[[World, int], None] | None = None,
 ) -> ReplayResult:
-    """Re-fly ``episode`` and compare every aircraft's states with the log (``callsign``:
-    judge that one only); ``on_step`` (a viewer such as FlightGear) is called after each
-    step."""
+    """Re-fly ``episode`` and compare every aircraft's states and rewards with the log
+    (``callsign``: judge that one only); ``on_step`` (a viewer such as FlightGear) is called
+    after each step."""
     if callsign is not None and callsign not in episode.steps:
         raise ConfigError(f"episode {episode.index} has no steps of {callsign!r}")
     own = world is None
@@ -80,8 +109,9 @@ def replay_episode(
         missing = sorted(set(episode.steps) - set(world.by_callsign))
         if missing:
             raise ConfigError(f"the world has no aircraft {missing} that the log flew")
-        world.reset(np.random.default_rng(int(episode.start["seed"])))
+        _reset(world, episode)
         logged = {c: (s.action, s.state) for c, s in episode.steps.items()}
+        seen = {team: episode.views(team) for team in world.team_slots} if world.external else {}
         length = max(len(s) for s in episode.steps.values())
         judged = [callsign] if callsign is not None else sorted(logged)
         first: dict[str, int | None] = dict.fromkeys(judged)
@@ -95,13 +125,19 @@ def replay_episode(
                 else:
                     a0, a1, a2, a3 = flown[0][i].tolist()
                     actions.append((a0, a1, a2, a3))
-            world.advance(actions)
+            world.step_physics(actions)
+            for views in seen.values():  # what an online team saw of the others: its rewards
+                if i < len(views):
+                    _show(world, views[i])
+            world.score()
             for c in judged:
                 states = logged[c][1]
                 if i >= len(states):
                     continue
-                state = world.by_callsign[c].state
-                if first[c] is None and not np.array_equal(state, states[i]):
+                slot = world.by_callsign[c]
+                state, reward = slot.state, episode.steps[c].reward[i]
+                same = np.array_equal(state, states[i]) and slot.reward == reward
+                if first[c] is None and not same:
                     first[c] = i
                 worst = max(worst, float(np.nanmax(np.abs(state - states[i]))))
             if on_step is not None:

@@ -133,9 +133,16 @@ class TrajectoryWriter:
         self._clock_ns = self._base_ns + step * self._dt_ns
 
     # -- episodes ------------------------------------------------------------------------
-    def start_episode(self, seed: int, starts: Sequence[Start], **info: Any) -> int:
-        """Open the next episode: its seed, every aircraft's start (target, position) and
-        ``info`` (source, iteration, ...)."""
+    def start_episode(
+        self,
+        seed: int,
+        starts: Sequence[Start],
+        options: Mapping[str, Any] | None = None,
+        **info: Any,
+    ) -> int:
+        """Open the next episode: its seed, every aircraft's start (target, position), the
+        reset ``options`` that replay needs (``rollout.records.reset_record``) and ``info``
+        (source, iteration, ...)."""
         if self._in_episode:
             raise RuntimeError("end or discard the current episode before starting another")
         self.episode += 1
@@ -149,6 +156,8 @@ class TrajectoryWriter:
             for s in starts
         }
         event = {"event": "start", "episode": self.episode, "seed": seed, "aircraft": aircraft}
+        if options:
+            event["options"] = dict(options)
         self._emit(self._events, {**event, **info})
         return self.episode
 
@@ -167,7 +176,8 @@ class TrajectoryWriter:
         """Log a whole flown episode and make it durable (``info``: source, iteration). The
         messages come in the order ``log_tick`` would have written them."""
         trajectories = list(episode.trajectories.values())
-        self.start_episode(episode.seed, [t.start for t in trajectories], **info)
+        starts = [t.start for t in trajectories]
+        self.start_episode(episode.seed, starts, episode.options, **info)
         steps = max((len(t) for t in trajectories), default=0)
         for k in range(steps):
             self._at_step(k + 1)
@@ -177,8 +187,7 @@ class TrajectoryWriter:
                 last = k == len(t) - 1
                 self.log_step(
                     t.callsign, k + 1, t.states[k], t.observations[k], t.actions[k], t.labels[k],
-                    t.rewards[k], t.terminated and last,
-                    episode.truncated and last and not t.terminated,
+                    t.rewards[k], t.terminated and last, t.truncated and last,
                     bool(t.interventions[k]),
                 )  # fmt: skip
             for team, views in episode.views.items():

@@ -34,7 +34,15 @@ from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import World
 from gymfg_il.errors import ConfigError, EnvStateError
-from gymfg_il.rollout.records import Episode, EpisodeBuilder, OpponentView, Start, Step, Tick
+from gymfg_il.rollout.records import (
+    Episode,
+    EpisodeBuilder,
+    OpponentView,
+    Start,
+    Step,
+    Tick,
+    reset_record,
+)
 
 NOISE_STREAM = 7919  # the noise of episode ``seed`` is drawn from default_rng([seed, 7919])
 
@@ -65,10 +73,12 @@ def step_records(
     before: dict[str, np.ndarray],
     labels: dict[str, np.ndarray],
     interventions: dict[str, bool],
-    truncated: bool,
+    ended: bool,
 ) -> list[Step]:
     """What the step just taken did to every aircraft that was flying (``before``): its
-    executed action, reward, state and flags as the world has them."""
+    executed action, reward, state and flags as the world has them. ``ended``: the episode
+    ends with this step (an aircraft still flying is then truncated: the time limit, the
+    server, or its opponents all having stopped cut its flight short)."""
     out = []
     for slot in world.slots:
         obs = before.get(slot.callsign)
@@ -86,7 +96,7 @@ def step_records(
                 float(slot.reward),
                 slot.state,
                 slot.terminated,
-                truncated and not slot.terminated,
+                ended and not slot.terminated,
                 interventions.get(slot.callsign, False),
                 slot.reason,
             )
@@ -130,7 +140,7 @@ class Rollout:
         team: Team | None = None,
     ) -> None:
         self.env, self.pilots, self.team = env, list(pilots), team
-        self.solo = isinstance(env, AircraftEnv)
+        self.solo = isinstance(getattr(env, "env", env), AircraftEnv)  # (a Recorder wraps)
         if not self.solo and team is None:
             raise ConfigError("a team env needs the team its pilots fly: Rollout(..., team=team)")
         n = 1 if self.solo else len(team.roster)  # type: ignore[union-attr]
@@ -208,7 +218,8 @@ class Rollout:
         else:
             team_state, opponents, _, terminated, truncated, info = self.env.step(np.hstack(flown))
             self._obs, self._opponents = list(team_state), opponents
-            after = observe_live(world)
+            # every aircraft that flew, terminated now or not: the observation its step led to
+            after = {c: world.observation(world.by_callsign[c]) for c in before}
             after.update({s.callsign: o for s, o in zip(own, team_state, strict=True)})
             names = tuple(getattr(self.env, "view", ()) or world.config.opponent_view)
             mine = (self.team.name, info.get("opponent_callsigns", []), opponents)  # type: ignore[union-attr]
@@ -216,9 +227,10 @@ class Rollout:
         self.done = bool(terminated or truncated)
         tick = Tick(
             world.steps,
-            step_records(world, before, labels, interventions, bool(truncated)),
+            step_records(world, before, labels, interventions, self.done),
             views,
             self.done,
+            bool(truncated),
         )
         self._after = after
         return tick
@@ -235,7 +247,9 @@ class Rollout:
         on_tick: Callable[[Tick], None] | None = None,
     ) -> Episode:
         """Reset with ``seed`` and fly to the end of the episode."""
-        builder = EpisodeBuilder(seed, self.world_dt(), self.reset(seed, options))
+        starts = self.reset(seed, options)
+        record = reset_record(options, starts[0].callsign if self.solo else None)
+        builder = EpisodeBuilder(seed, self.world_dt(), starts, record)
         while not self.done:
             tick = self.step()
             builder.add(tick, self._after)

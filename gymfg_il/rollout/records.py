@@ -7,10 +7,30 @@ through the same loop (``rollout.loop.Rollout``), so every consumer sees the sam
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+
+from gymfg_il.envs.roster import plain
+
+
+def reset_record(options: Mapping[str, Any] | None, solo: str | None = None) -> dict[str, Any]:
+    """Reset options as a log records them (what replay needs to start the same episode):
+    ``initial_conditions`` per callsign (``solo``: the callsign of a gymnasium env's one
+    aircraft, whose option is a bare ``InitialConditions``) and a fixed ``target``."""
+    out: dict[str, Any] = {}
+    if not options:
+        return out
+    ics = options.get("initial_conditions")
+    if ics is not None:
+        if solo is not None and not isinstance(ics, Mapping):
+            ics = {solo: ics}
+        out["initial_conditions"] = {str(c): plain(ic) for c, ic in ics.items()}
+    if options.get("target") is not None:
+        out["target"] = float(options["target"])
+    return out
 
 
 @dataclass(slots=True)
@@ -63,6 +83,7 @@ class Tick:
     steps: list[Step]
     views: dict[str, OpponentView] = field(default_factory=dict)
     done: bool = False
+    truncated: bool = False  # the episode reached its time limit (or its server ended it)
 
 
 @dataclass
@@ -92,6 +113,7 @@ class Trajectory:
     interventions: np.ndarray
     terminated: bool
     reason: str | None
+    truncated: bool = False  # its flight was cut short when the episode ended
 
     @property
     def callsign(self) -> str:
@@ -122,6 +144,7 @@ class Episode:
     trajectories: dict[str, Trajectory]
     views: dict[str, list[OpponentView]] = field(default_factory=dict)
     truncated: bool = False
+    options: dict[str, Any] = field(default_factory=dict)  # reset options (reset_record)
 
     @property
     def solo(self) -> Trajectory:
@@ -159,8 +182,10 @@ class Episode:
 class EpisodeBuilder:
     """Gathers ticks into an ``Episode``."""
 
-    def __init__(self, seed: int, dt: float, starts: list[Start]) -> None:
-        self.seed, self.dt, self.starts = seed, dt, starts
+    def __init__(
+        self, seed: int, dt: float, starts: list[Start], options: dict[str, Any] | None = None
+    ) -> None:
+        self.seed, self.dt, self.starts, self.options = seed, dt, starts, options or {}
         self.steps: dict[str, list[Step]] = {s.callsign: [] for s in starts}
         self.views: dict[str, list[OpponentView]] = {}
         self.final: dict[str, np.ndarray] = {s.callsign: s.observation for s in starts}
@@ -170,7 +195,7 @@ class EpisodeBuilder:
         """Take a tick and the observations after it."""
         for step in tick.steps:
             self.steps[step.callsign].append(step)
-            self.truncated = self.truncated or step.truncated
+        self.truncated = self.truncated or tick.truncated
         for team, view in tick.views.items():
             self.views.setdefault(team, []).append(view)
         self.final.update(observations)
@@ -194,5 +219,6 @@ class EpisodeBuilder:
                 interventions=np.array([s.intervention for s in steps], bool),
                 terminated=bool(last and last.terminated),
                 reason=last.reason if last else None,
+                truncated=bool(last and last.truncated),
             )
-        return Episode(self.seed, self.dt, trajectories, self.views, self.truncated)
+        return Episode(self.seed, self.dt, trajectories, self.views, self.truncated, self.options)

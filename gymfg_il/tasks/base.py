@@ -7,6 +7,7 @@ reward without a subclass is one lambda: ``DummyTask(reward=lambda ctx: ...)``.
 
 from __future__ import annotations
 
+import inspect
 from typing import Any, ClassVar
 
 import numpy as np
@@ -48,8 +49,25 @@ class Task:
     """
 
     name: ClassVar[str] = "task"
+    _call: tuple[tuple[Any, ...], dict[str, Any]] = ((), {})
     observation_vars: ClassVar[tuple[str, ...]] = FLIGHT_VARS
     extra_names: ClassVar[tuple[str, ...]] = ()
+
+    def __new__(cls, *args: Any, **kwargs: Any) -> Task:
+        # the arguments of the construction, whatever the subclass takes: what a flight spec
+        # records (``options``) to build the same task again
+        task = super().__new__(cls)
+        task._call = (args, dict(kwargs))
+        return task
+
+    @property
+    def options(self) -> dict[str, Any]:
+        """The arguments this task was built with, by name (a flight spec records them)."""
+        args, kwargs = self._call
+        if not args:
+            return dict(kwargs)
+        bound = inspect.signature(type(self)).bind_partial(*args, **kwargs)
+        return dict(bound.arguments)
 
     def __init__(
         self,
@@ -69,12 +87,6 @@ class Task:
         self._custom_reward = reward
         self.history_window = history_window
         self.start = start
-        # the arguments this task was built with (a flight spec records and rebuilds them)
-        self.options: dict[str, Any] = {
-            k: v
-            for k, v in (("reward", reward), ("history_window", history_window), ("start", start))
-            if v is not None and v != 0
-        }
         self._obs_idx = indices(self.observation_vars)
         self._n_vars = len(self.observation_vars)
         self.aircraft: Aircraft | None = None

@@ -91,14 +91,6 @@ class TargetTask(Task):
         **kwargs: object,
     ) -> None:
         super().__init__(**kwargs)  # type: ignore[arg-type]
-        given = {
-            "target": target,
-            "target_range": target_range,
-            "hold_s": hold_s,
-            "reward_scale": reward_scale,
-            "tolerance": tolerance,
-        }
-        self.options.update({k: v for k, v in given.items() if v is not None})
         hold_s = 20.0 if hold_s is None else hold_s
         fam = self.family
         self.target_range = tuple(target_range) if target_range is not None else fam.target_range

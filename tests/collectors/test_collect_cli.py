@@ -140,3 +140,15 @@ def test_replay_into_a_view_sends_every_step_and_checks_every_state(tmp_path, ca
                 break
     assert "ego: 20 steps, identical" in capsys.readouterr().out
     assert len(packets) == 21 and {len(p) for p in packets} == {408}  # the reset, then 20 steps
+
+
+def test_recipe_overrides_take_each_kind_its_own_flags(capsys):
+    from pathlib import Path
+
+    recipes = Path(__file__).resolve().parents[2] / "collectors"
+    args = collect.parse_args([str(recipes / "manual-keyboard.toml"), "--fps", "10"])
+    assert args.agent_hz == 10 and "noise" not in vars(args)
+    assert collect.main([str(recipes / "sample.toml"), "--device", "mouse"]) == 2
+    assert "apply to manual recipes" in capsys.readouterr().err
+    assert collect.main([str(recipes / "manual-keyboard.toml"), "--noise", "0.1"]) == 2
+    assert "apply to autopilot recipes" in capsys.readouterr().err

@@ -159,3 +159,15 @@ def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
     flying = [f for f in drawn if f.status != "idle"]
     assert flying and all(f.target_name == "altitude_ft (ft)" for f in flying)
     assert all(abs(f.target - f.actual) <= 1000 for f in flying)
+
+
+def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
+    import json
+
+    policy = tmp_path / "policy"
+    policy.mkdir()
+    (policy / "model.safetensors").write_bytes(b"not read")
+    spec = FlightSpec.solo("c172p", "altitude", agent_hz=10)
+    (policy / "config.json").write_text(json.dumps({"spec": spec.to_dict(), "fps": 10}))
+    with pytest.raises(ConfigError, match=r"trained at 10 Hz.*at 30 Hz"):
+        ManualSession(SPEC, tmp_path / "out", assist=str(policy), realtime=False)

@@ -128,3 +128,50 @@ def test_what_a_record_cannot_rebuild_is_named():
     with pytest.raises(ConfigError, match="cannot rebuild"):
         spec.build_teams()
     env.close()
+
+
+class StopAfter(DummyTask):
+    """A task of one's own with an argument of its own."""
+
+    def __init__(self, stop_after: int, **kwargs):
+        super().__init__(**kwargs)
+        self.stop_after = stop_after
+
+
+def test_a_tasks_own_arguments_are_recorded_whatever_its_signature():
+    import functools
+
+    for build in (lambda: StopAfter(15), functools.partial(StopAfter, stop_after=15)):
+        team = Team("ego", [(c172p("ego"), build)])
+        env = OfflineEnv()
+        env.reset(team, seed=0)
+        spec = FlightSpec.of_world(env.world)
+        (ego,) = spec.aircraft_specs
+        assert ego.task.endswith(":StopAfter") and dict(ego.task_kwargs) == {"stop_after": 15}
+        env.close()
+
+
+def test_specs_are_immutable_hashable_and_check_their_parts():
+    spec = FlightSpec.solo(task_kwargs={"target_range": [-100, 100]})
+    again = FlightSpec.from_json(spec.to_json())
+    assert again == spec and hash(again) == hash(spec) and len({spec, again}) == 1
+    with pytest.raises(TypeError, match=r"FlightSpec\.replace"):
+        spec.task_kwargs["target_range"] = (0, 1)
+    assert spec.replace(task_kwargs={"target_range": (0, 1)}).task_kwargs["target_range"] == (0, 1)
+    record = spec.to_dict()
+    record["teams"][0]["reward_targets"] = {"nobody": [{"callsign": "ego", "model": "c172p"}]}
+    with pytest.raises(ConfigError, match="not in its roster"):
+        FlightSpec.from_dict(record)
+    with pytest.raises(ConfigError, match="twice"):
+        FlightSpec.solo().replace(opponent_view=("lat_deg", "lat_deg"))
+    for bad in ({**spec.to_dict(), "agent_hz": "10"}, {**spec.to_dict(), "episode_time_s": None}):
+        with pytest.raises(ConfigError):
+            FlightSpec.from_dict(bad)
+    odd = spec.replace(scenario={"name": "barrel_roll"})
+    assert "barrel_roll" in odd.rebuild_problems()[0]
+    lead = formation(lead=InitialConditions(altitude_ft=3000), spacing_ft=100)
+    from gymfg_il.envs.scenarios import scenario_record
+
+    placed = spec.replace(scenario=scenario_record(lead))
+    back = FlightSpec.from_json(placed.to_json())
+    assert back == placed and back.env_config().scenario == lead

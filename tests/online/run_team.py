@@ -9,10 +9,20 @@ from gymfg_il import Team
 from gymfg_il.aircraft import c172p, f15
 from gymfg_il.controllers.autopilot import controller_for
 from gymfg_il.tasks import (
+    DummyTask,
     ReachStaticTargetAltitudeTask,
     ReachStaticTargetHeadingTask,
     ReachStaticTargetRollTask,
+    geometry,
 )
+
+
+class ChaseTask(DummyTask):
+    """Rewarded for closing on blue-1, an opponent seen only through the server."""
+
+    def task_reward(self, ctx):
+        blue = ctx.targets["blue-1"]
+        return -geometry.distance_ft(ctx.state, blue) / 1e4
 
 
 def teams(seconds: float) -> dict[str, Team]:

@@ -123,3 +123,22 @@ def test_a_run_whose_tasks_the_record_cannot_rebuild_replays_with_them(tmp_path)
         world_for(log)
     world = world_for(log, teams=[team()])
     assert replay_episode(log, log.complete_episodes[0], world=world).identical
+
+
+def test_reset_options_and_the_reason_of_the_end_are_logged(tmp_path):
+    from gymfg_il.envs import AircraftEnv
+    from gymfg_il.sim.initial import InitialConditions
+
+    env = Recorder(AircraftEnv("altitude", "c172p", episode_time_s=30), tmp_path)
+    start = InitialConditions(altitude_ft=350, airspeed_kts=105, heading_deg=90)
+    env.reset(seed=4, options={"initial_conditions": start, "target": 120.0})
+    done = False
+    while not done:  # nose down from 350 ft: a crash, not the time limit
+        _, _, terminated, truncated, _ = env.step(np.array([0.0, 0.6, 0.0, 0.6]))
+        done = terminated or truncated
+    env.close()
+    log = read_log(next((tmp_path / "logs").glob("*.mcap")))
+    (ep,) = log.complete_episodes
+    assert ep.end["outcome"] == "crashed"
+    assert ep.start_of("ego")["target"] == pytest.approx(350 + 120.0, abs=1)
+    assert replay_episode(log, ep).identical  # from the logged start and target

@@ -106,3 +106,24 @@ def test_episodes_on_workers_are_the_episodes_of_one_process():
     hand = Rollout(env, [AgentSpec.controller().make(env)], noise=0.05).episode(3)
     assert np.array_equal(hand.solo.actions, one[0].solo.actions)
     env.close()
+
+
+def test_when_a_team_crashes_the_others_are_cut_short_and_the_outcome_says_why():
+    from gymfg_il.sim.initial import InitialConditions
+
+    red = Team("red", [(c172p("red-1"), ReachStaticTargetAltitudeTask)], episode_time_s=60)
+    blue = Team("blue", [(f15("blue-1"), ReachStaticTargetRollTask)])
+    env = OfflineEnv(opponents=[(blue, [ConstantAgent((0.0, 0.0, 0.0, 0.8))])])
+    low = {"initial_conditions": {"red-1": InitialConditions(altitude_ft=400, airspeed_kts=110)}}
+    dive = ConstantAgent((0.0, 1.0, 0.0, 0.7))  # full nose down from 400 ft
+    episode = Rollout(env, [dive], team=red).episode(3, options=low)
+    red_t, blue_t = episode.trajectories["red-1"], episode.trajectories["blue-1"]
+    assert red_t.terminated and red_t.reason == "crashed" and not red_t.truncated
+    assert blue_t.truncated and not blue_t.terminated and len(blue_t) == len(red_t)
+    assert episode.outcome == "crashed" and not episode.truncated
+    assert (
+        episode.options["initial_conditions"]["red-1"]["initial_conditions"]["altitude_ft"] == 400
+    )
+    # the last observation of each aircraft is the one its own last step led to
+    assert not np.array_equal(red_t.final_observation, red_t.observations[-1])
+    env.close()
