@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -9,7 +10,7 @@ from pathlib import Path
 from gymfg_il.collectors.session import DATASET, LOGS
 from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
 from gymfg_il.errors import ConfigError
-from gymfg_il.recording.reader import read_log
+from gymfg_il.recording.reader import EmptyLog, read_log
 from gymfg_il.recording.replay import replay_episode, world_for
 
 
@@ -57,6 +58,12 @@ def report_build(report: BuildReport, root: Path) -> None:
             f"left out {r.skipped_incomplete} unfinished episode(s) (the session stopped "
             "mid-episode)"
         )
+    for name in r.skipped_empty:
+        print(f"skipped {name}: a session stopped before writing anything to it")
+    if r.damage:
+        print("damaged logs: what could not be read is left out:", file=sys.stderr)
+        for line in r.damage:
+            print(f"  {line}", file=sys.stderr)
 
 
 def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
@@ -65,7 +72,16 @@ def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
     if not paths:
         raise ConfigError(f"no logs under {target}")
     failures = 0
-    logs = [read_log(path) for path in paths]
+    logs = []
+    for path in paths:
+        try:
+            logs.append(read_log(path))
+        except EmptyLog:
+            print(f"skipped {path.name}: a session stopped before writing anything to it")
+    for lg in logs:
+        for note in lg.damage:
+            print(f"{lg.path.name}: could not read {note}", file=sys.stderr)
+            failures += 1
     if episode is not None and not any(
         e.index == episode for lg in logs for e in lg.complete_episodes
     ):
@@ -101,4 +117,4 @@ def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
         )
     report = build_from_logs(logs, folder / DATASET, callsigns=callsigns or None)
     report_build(report, folder / DATASET)
-    return 0
+    return 1 if report.damage else 0  # the dataset holds all that could be read

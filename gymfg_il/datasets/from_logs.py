@@ -13,7 +13,7 @@ import math
 import shutil
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +23,7 @@ from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.features import dataset_features
 from gymfg_il.errors import ConfigError
-from gymfg_il.recording.reader import Log, LoggedEpisode, read_log
+from gymfg_il.recording.reader import EmptyLog, Log, LoggedEpisode, read_log
 
 log = logging.getLogger(__name__)
 
@@ -36,6 +36,8 @@ class BuildReport:
     total_episodes: int
     seconds: float
     rebuilt: bool
+    damage: list[str] = field(default_factory=list)  # "log: what was lost and why"
+    skipped_empty: list[str] = field(default_factory=list)  # logs never written to
 
 
 def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarray]:
@@ -77,11 +79,29 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
 
 
 def _dataset_ok(root: Path) -> bool:
+    """Whether the dataset at ``root`` is whole: its metadata loads, its statistics and task
+    table are there, and its data files are readable parquet holding every frame."""
+    import pyarrow.parquet as pq
+
     try:
         meta = lr.open_metadata(root)
-        return meta.episodes is None or len(meta.episodes) == meta.total_episodes
+        if meta.episodes is not None and len(meta.episodes) != meta.total_episodes:
+            return False
+        if not (root / "meta" / "stats.json").is_file() or meta.stats is None:
+            return False
+        if not (root / "meta" / "tasks.parquet").is_file():
+            return False
+        rows = sum(pq.ParquetFile(p).metadata.num_rows for p in (root / "data").rglob("*.parquet"))
+        return bool(rows == meta.total_frames)
     except Exception:  # any failure to load means: rebuild from the logs
         return False
+
+
+def _clean_leftovers(root: Path) -> None:
+    """Copies an interrupted build left beside the dataset (the good one is in place now)."""
+    for pattern in (f"{root.name}.building-*", f"{root.name}.old-*"):
+        for leftover in root.parent.glob(pattern):
+            shutil.rmtree(leftover, ignore_errors=True)
 
 
 def _present(root: Path) -> set[tuple[str, int, str]]:
@@ -145,7 +165,14 @@ def _build(
 ) -> BuildReport:
     lr.load()  # LeRobot's import is not build time
     started = time.perf_counter()
-    logs: list[Log] = [read_log(p) for p in sorted(log_paths)]
+    logs: list[Log] = []
+    empty: list[str] = []
+    for path in sorted(log_paths):
+        try:
+            logs.append(read_log(path))
+        except EmptyLog:
+            log.warning("skipped %s: a session stopped before writing anything to it", path)
+            empty.append(path.name)
     if not logs:
         raise ConfigError(f"no trajectory logs to build {root} from")
     chosen = _chosen(logs, callsigns)
@@ -203,4 +230,7 @@ def _build(
         shutil.rmtree(old)
     else:
         work.rename(root)
-    return BuildReport(added, frames, skipped, total, time.perf_counter() - started, rebuilt)
+    _clean_leftovers(root)
+    damage = [f"{lg.path.name}: {note}" for lg in logs for note in lg.damage]
+    seconds = time.perf_counter() - started
+    return BuildReport(added, frames, skipped, total, seconds, rebuilt, damage, empty)

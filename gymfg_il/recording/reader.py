@@ -1,32 +1,31 @@
-"""Reading MCAP trajectory logs, finished or not (a killed session leaves no footer)."""
+"""Reading MCAP trajectory logs, finished or not (a killed session leaves no footer), damaged
+or not (a bad chunk costs the episodes it held, and ``Log.damage`` says which and why)."""
 
 from __future__ import annotations
 
 import gc
-import json
-import struct
-import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import orjson
-import zstandard
-from mcap.exceptions import McapError
-from mcap.records import Channel, Chunk, Message, Metadata
-from mcap.stream_reader import StreamReader
 
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import GymFGError
-from gymfg_il.recording.session import SESSION_METADATA, spec_of, upgrade
-from gymfg_il.recording.writer import EPISODE_TOPIC
+from gymfg_il.recording.mcap_walk import MAGIC, Damage
+from gymfg_il.recording.messages import Sorter, stream
+from gymfg_il.recording.session import spec_of, upgrade
 from gymfg_il.rollout.records import OpponentView
 from gymfg_il.sim.properties import ACTION_NAMES, NAMES
 
 
 class LogError(GymFGError, ValueError):
     """A file that is not a GymFG trajectory log, or is damaged beyond its first bytes."""
+
+
+class EmptyLog(LogError):
+    """A log file a session created but never wrote to (killed before its first fsync)."""
 
 
 @dataclass
@@ -44,7 +43,8 @@ class AircraftSteps:
     terminated: np.ndarray
     truncated: np.ndarray
     intervention: np.ndarray
-    raw_states: list[bytes] = field(default_factory=list, repr=False)
+    numbers: list[int] = field(default_factory=list, repr=False)  # the logged step numbers
+    raw_states: list[Any] = field(default_factory=list, repr=False)
     _state: np.ndarray | None = field(default=None, repr=False)
 
     @property
@@ -65,11 +65,25 @@ class LoggedEpisode:
     end: dict[str, Any] | None = None
     discarded: bool = False
     steps: dict[str, AircraftSteps] = field(default_factory=dict)
-    raw_views: dict[str, list[bytes]] = field(default_factory=dict, repr=False)
+    raw_views: dict[str, list[Any]] = field(default_factory=dict, repr=False)
 
     @property
     def complete(self) -> bool:
-        return self.end is not None and not self.discarded
+        return self.end is not None and not self.discarded and not self.gaps()
+
+    def gaps(self) -> str:
+        """What is missing from an ended episode (steps or states lost to damage), or ""."""
+        steps = self.end.get("steps") if self.end else None
+        for callsign, s in self.steps.items():
+            if s.numbers != list(range(1, len(s) + 1)):
+                return f"{callsign}'s steps are not 1..{len(s)} (some were lost)"
+            if len(s.raw_states) != len(s):
+                return f"{callsign} has {len(s)} steps but {len(s.raw_states)} states"
+        if isinstance(steps, int) and self.steps and max(map(len, self.steps.values())) != steps:
+            return f"it ended after {steps} steps but {max(map(len, self.steps.values()))} remain"
+        if self.end is not None and not self.steps and steps:
+            return "all its steps were lost"
+        return ""
 
     def start_of(self, callsign: str) -> dict[str, Any]:
         """``callsign``'s start: ``target`` and ``initial_state`` (older logs: the episode's)."""
@@ -93,6 +107,7 @@ class Log:
     session: dict[str, Any]
     episodes: list[LoggedEpisode]
     finished: bool  # the file has its footer (the session closed cleanly)
+    damage: list[str] = field(default_factory=list)  # what could not be read, and why
 
     @property
     def complete_episodes(self) -> list[LoggedEpisode]:
@@ -112,7 +127,7 @@ class Log:
             raise LogError(f"{self.path.name} records no aircraft {callsign!r}") from None
 
 
-def _steps(rows: list[dict[str, Any]], states: list[bytes]) -> AircraftSteps:
+def _steps(rows: list[dict[str, Any]], states: list[Any]) -> AircraftSteps:
     # The writer keeps the contract's action order; read values in bulk when the keys say so.
     if list(rows[0]["action"]) == list(ACTION_NAMES):
         action = [list(r["action"].values()) for r in rows]
@@ -128,137 +143,50 @@ def _steps(rows: list[dict[str, Any]], states: list[bytes]) -> AircraftSteps:
         terminated=np.array([r.get("terminated", False) for r in rows], dtype=bool),
         truncated=np.array([r.get("truncated", False) for r in rows], dtype=bool),
         intervention=np.array([r.get("intervention", False) for r in rows], dtype=bool),
+        numbers=[int(r["step"]) for r in rows],
         raw_states=states,
     )
 
 
-_RECORD = struct.Struct("<BQ")
-_CHANNEL_HEAD = struct.Struct("<HHI")
-_MESSAGE_HEAD = struct.Struct("<H")
-
-
-def _chunk_messages(chunk: Chunk, seen: _Collector) -> None:
-    """Feed every channel and message of a chunk to ``seen``.
-
-    The mcap library's ``breakup_chunk`` builds a record object per message; a log holds
-    tens of thousands of them, so this walks the chunk's records with ``struct`` instead and
-    checks the chunk's CRC itself.
-    """
-    if chunk.compression == "zstd":
-        data = zstandard.decompress(chunk.data, max_output_size=chunk.uncompressed_size)
-    elif chunk.compression == "":
-        data = chunk.data
-    else:
-        raise LogError(f"unsupported chunk compression {chunk.compression!r}")
-    if chunk.uncompressed_crc and zlib.crc32(data) != chunk.uncompressed_crc:
-        raise LogError("a chunk fails its CRC check")
-    pos, end = 0, len(data)
-    kinds, message = seen.kinds, seen.message
-    while pos < end:
-        opcode, length = _RECORD.unpack_from(data, pos)
-        body = pos + 9
-        if opcode == 0x05:  # Message: channel_id u16, sequence u32, log/publish time u64
-            (channel_id,) = _MESSAGE_HEAD.unpack_from(data, body)
-            if channel_id in kinds:
-                message(channel_id, data[body + 22 : body + length])
-        elif opcode == 0x04:  # Channel: id u16, schema_id u16, topic (u32 length + bytes)
-            channel_id, _, size = _CHANNEL_HEAD.unpack_from(data, body)
-            seen.channel(channel_id, data[body + 8 : body + 8 + size].decode())
-        pos = body + length
-
-
-class _Collector:
-    """Sorts a log's messages by kind as they stream past (only what a dataset needs is
-    decoded; full states are kept as bytes until asked for)."""
-
-    def __init__(self) -> None:
-        self.kinds: dict[int, tuple[str, str]] = {}
-        self.events: list[dict[str, Any]] = []
-        self.rows: dict[tuple[int, str], list[dict[str, Any]]] = {}
-        self.states: dict[tuple[int, str], list[bytes]] = {}
-        self.views: dict[tuple[int, str], list[bytes]] = {}
-        self._last: dict[str, tuple[int, str]] = {}
-        self._episode = -1
-
-    def channel(self, channel_id: int, topic: str) -> None:
-        if topic == EPISODE_TOPIC:
-            self.kinds[channel_id] = ("episode", "")
-            return
-        parts = topic.split("/")
-        if len(parts) == 4 and parts[1] == "gymfg" and parts[3] in ("step", "state"):
-            self.kinds[channel_id] = (parts[3], parts[2])
-        elif len(parts) == 5 and parts[1:3] == ["gymfg", "team"] and parts[4] == "opponents":
-            self.kinds[channel_id] = ("view", parts[3])
-
-    def message(self, channel_id: int, data: bytes) -> None:
-        kind = self.kinds.get(channel_id)
-        if kind is None:
-            return
-        what, callsign = kind
-        if what == "step":
-            msg = orjson.loads(data)
-            key = (int(msg["episode"]), callsign)
-            self.rows.setdefault(key, []).append(msg)
-            self._last[callsign] = key
-        elif what == "state":
-            # written right after its step message: same episode
-            last = self._last.get(callsign)
-            if last is not None:
-                self.states.setdefault(last, []).append(data)
-        elif what == "view":  # written after the steps of its tick: same episode
-            self.views.setdefault((self._episode, callsign), []).append(data)
-        else:
-            event = orjson.loads(data)
-            self._episode = int(event.get("episode", -1))
-            self.events.append(event)
-
-
-def _stream(path: Path, seen: _Collector) -> tuple[dict[str, Any] | None, bool]:
-    """Stream the log's records into ``seen``; return (session record, file finished?)."""
-    session: dict[str, Any] | None = None
-    with open(path, "rb") as f:
-        reader = StreamReader(f, validate_crcs=True, emit_chunks=True)
-        try:
-            for record in reader.records:
-                if isinstance(record, Chunk):
-                    _chunk_messages(record, seen)
-                elif isinstance(record, Channel):
-                    seen.channel(record.id, record.topic)
-                elif isinstance(record, Metadata) and record.name == SESSION_METADATA:
-                    session = {k: json.loads(v) for k, v in record.metadata.items()}
-                elif isinstance(record, Message):
-                    seen.message(record.channel_id, record.data)
-        except (McapError, EOFError, ValueError, OSError, KeyError, struct.error) as err:
-            if session is None:
-                raise LogError(
-                    f"{path} is not a readable GymFG trajectory log ({type(err).__name__}: "
-                    f"{err}); it holds no session record"
-                ) from None
-            return session, False
-    return session, True
-
-
 def read_log(path: Path) -> Log:
-    """Everything readable in ``path``; an unfinished file yields its durable part."""
+    """Everything readable in ``path``: an unfinished file yields its durable part, a
+    damaged one every episode the damage does not touch (``Log.damage`` says what was lost
+    and why)."""
     path = Path(path)
     if not path.is_file():
         raise LogError(f"no trajectory log at {path}")
-    seen = _Collector()
+    data = path.read_bytes()
+    if not data.startswith(MAGIC[: len(data)]) or (len(data) >= len(MAGIC) and data[:8] != MAGIC):
+        raise LogError(f"{path} is not a readable GymFG trajectory log (not an MCAP file)")
+    seen = Sorter()
+    damage: list[Damage] = []
     # Tens of thousands of small decoded messages would trigger the cyclic GC many times
     # over; none of them form cycles.
     gc_was_enabled = gc.isenabled()
     gc.disable()
     try:
-        session, finished = _stream(path, seen)
+        session, finished = stream(data, seen, damage)
     finally:
         if gc_was_enabled:
             gc.enable()
     if session is None:
-        raise LogError(f"{path} has no {SESSION_METADATA} record: not a GymFG trajectory log")
-    session = upgrade(session)
-    events, rows, states = seen.events, seen.rows, seen.states
+        if not seen.events:
+            raise EmptyLog(
+                f"{path} holds no session record and no episode (a session stopped before "
+                "its first write); nothing in it to keep"
+            )
+        raise LogError(
+            f"{path} is not a readable GymFG trajectory log: its session record is lost "
+            f"({'; '.join(map(str, damage)) or 'none was written'})"
+        )
+    episodes = _episodes(seen)
+    notes = [str(d) for d in damage] + _lost(episodes)
+    return Log(path, upgrade(session), episodes, finished, notes)
+
+
+def _episodes(seen: Sorter) -> list[LoggedEpisode]:
     episodes: dict[int, LoggedEpisode] = {}
-    for ev in events:
+    for ev in seen.events:
         k = ev["episode"]
         if ev["event"] == "start":
             episodes[k] = LoggedEpisode(k, ev)
@@ -266,10 +194,24 @@ def read_log(path: Path) -> Log:
             episodes[k].end = ev
         elif k in episodes and ev["event"] == "discard":
             episodes[k].discarded = True
-    for (k, callsign), msgs in rows.items():
+    for (k, callsign), msgs in seen.rows.items():
         if k in episodes:
-            episodes[k].steps[callsign] = _steps(msgs, states.get((k, callsign), []))
+            episodes[k].steps[callsign] = _steps(msgs, seen.states.get((k, callsign), []))
     for (k, team), views in seen.views.items():
         if k in episodes:
             episodes[k].raw_views[team] = views
-    return Log(path, session, [episodes[k] for k in sorted(episodes)], finished)
+    return [episodes[k] for k in sorted(episodes)]
+
+
+def _lost(episodes: list[LoggedEpisode]) -> list[str]:
+    """Episodes that damage took: ended but missing steps, or never ended although later
+    episodes began (the last one unended is where a session stopped, not damage)."""
+    notes = []
+    for i, ep in enumerate(episodes):
+        if ep.discarded:
+            continue
+        if ep.end is not None and ep.gaps():
+            notes.append(f"episode {ep.index}: {ep.gaps()}; left out")
+        elif ep.end is None and i < len(episodes) - 1:
+            notes.append(f"episode {ep.index}: its end was lost; left out")
+    return notes

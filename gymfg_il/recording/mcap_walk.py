@@ -1,0 +1,144 @@
+"""Walking an MCAP file's records by hand, so that damage costs only what it touches.
+
+Chunks decode independently: a chunk that fails to decompress or fails its CRC is skipped and
+reported, and the walk goes on with the next record. A record whose header is garbage (a bad
+opcode or a length that cannot be) is skipped by searching forward for the next record that
+parses as a whole chunk. A record cut off by the end of the file is where a killed session
+stopped writing (not damage), unless a whole chunk follows it. The mcap library's readers stop
+at the first bad byte; this one keeps every episode the damage does not reach.
+
+Layout (little endian): magic, then records of ``opcode u8, length u64, body``; a chunk body
+is ``start u64, end u64, uncompressed_size u64, uncompressed_crc u32, compression (u32 length
++ bytes), records (u64 length + bytes)``.
+"""
+
+from __future__ import annotations
+
+import struct
+import zlib
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import zstandard
+
+MAGIC = b"\x89MCAP0\r\n"
+HEADER, FOOTER, SCHEMA, CHANNEL, MESSAGE, CHUNK = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06
+METADATA, DATA_END = 0x0C, 0x0F
+KNOWN = set(range(0x01, 0x10))
+_RECORD = struct.Struct("<BQ")
+_CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
+_U32 = struct.Struct("<I")
+_U64 = struct.Struct("<Q")
+_MAX_CHUNK = 1 << 30
+
+
+@dataclass
+class Damage:
+    """A part of a file that could not be read: where, and why."""
+
+    start: int
+    end: int
+    why: str
+
+    def __str__(self) -> str:
+        return f"bytes {self.start}-{self.end}: {self.why}"
+
+
+def _chunk_at(data: bytes, pos: int) -> int | None:
+    """The end of the chunk record at ``pos``, if a whole, self-consistent one is there."""
+    if pos + 9 + _CHUNK.size > len(data) or data[pos] != CHUNK:
+        return None
+    (length,) = _U64.unpack_from(data, pos + 1)
+    end = pos + 9 + length
+    if end > len(data) or length > _MAX_CHUNK:
+        return None
+    _, _, size, _, clen = _CHUNK.unpack_from(data, pos + 9)
+    head = pos + 9 + _CHUNK.size
+    if clen not in (0, 4) or size > _MAX_CHUNK or head + clen + 8 > end:
+        return None
+    if data[head : head + clen] not in (b"", b"zstd"):
+        return None
+    (records,) = _U64.unpack_from(data, head + clen)
+    return end if head + clen + 8 + records == end else None
+
+
+def _next_chunk(data: bytes, start: int) -> int | None:
+    """The offset of the next whole chunk record at or after ``start``."""
+    pos = data.find(bytes([CHUNK]), start)
+    while pos != -1:
+        if _chunk_at(data, pos) is not None:
+            return pos
+        pos = data.find(bytes([CHUNK]), pos + 1)
+    return None
+
+
+def records(data: bytes, damage: list[Damage]) -> Iterator[tuple[int, int, memoryview]]:
+    """(offset, opcode, body) of every readable top-level record; what cannot be read goes
+    to ``damage``. Stops at the footer, or where the file ends (a session killed mid-write)."""
+    view = memoryview(data)
+    pos = len(MAGIC)
+    while pos + 9 <= len(data):
+        opcode, length = _RECORD.unpack_from(data, pos)
+        end = pos + 9 + length
+        sane = opcode in KNOWN and length <= len(data)
+        if sane and end <= len(data) and (opcode != CHUNK or _chunk_at(data, pos) is not None):
+            yield pos, opcode, view[pos + 9 : end]
+            if opcode == FOOTER:
+                return
+            pos = end
+            continue
+        resume = _next_chunk(data, pos + 1)
+        if resume is None:
+            if sane:
+                return  # cut off by the end of the file: where the writer was killed
+            damage.append(Damage(pos, len(data), "unreadable records to the end of the file"))
+            return
+        damage.append(Damage(pos, resume, f"a damaged record (opcode {opcode:#04x})"))
+        pos = resume
+
+
+def chunk_data(body: memoryview) -> bytes:
+    """The records of a chunk, decompressed and checked; ValueError when they cannot be read
+    (it does not decompress, fails its CRC, or, without a CRC, a record runs past its end)."""
+    _, _, size, crc, clen = _CHUNK.unpack_from(body, 0)
+    head = _CHUNK.size
+    compression = bytes(body[head : head + clen])
+    raw = body[head + clen + 8 :]
+    if compression == b"zstd":
+        try:
+            inner = zstandard.decompress(raw, max_output_size=size)
+        except zstandard.ZstdError as err:
+            raise ValueError(f"a chunk does not decompress ({err})") from None
+    elif compression == b"":
+        inner = bytes(raw)
+    else:
+        raise ValueError(f"unsupported chunk compression {compression!r}")
+    if crc:
+        if zlib.crc32(inner) != crc:
+            raise ValueError("a chunk fails its CRC check")
+        return inner  # the CRC vouches for every record length inside
+    pos, end = 0, len(inner)
+    while pos < end:
+        if pos + 9 > end:
+            raise ValueError("a chunk ends inside a record header")
+        pos += 9 + _RECORD.unpack_from(inner, pos)[1]
+    if pos != end:
+        raise ValueError("a record runs past the end of its chunk")
+    return inner
+
+
+def string_map(body: memoryview, pos: int) -> dict[str, str]:
+    """An MCAP map<string, string> at ``pos``."""
+    (size,) = _U32.unpack_from(body, pos)
+    pos, end, out = pos + 4, pos + 4 + size, {}
+    while pos < end:
+        key, pos = string(body, pos)
+        value, pos = string(body, pos)
+        out[key] = value
+    return out
+
+
+def string(body: memoryview, pos: int) -> tuple[str, int]:
+    """An MCAP string (u32 length + UTF-8) at ``pos``, and the position after it."""
+    (size,) = _U32.unpack_from(body, pos)
+    return bytes(body[pos + 4 : pos + 4 + size]).decode(), pos + 4 + size
