@@ -151,8 +151,13 @@ def _autopilot(args: argparse.Namespace) -> int:
         return tick
 
     result, report = collect_autopilot(cfg, args.workers, progress)
-    print(f"logged {len(result.episodes)} episodes ({result.steps} steps) to {result.log}")
-    report_build(report, cfg.out / "dataset")
+    if result.log is None:
+        print(f"nothing to fly: the dataset at {cfg.out / 'dataset'} holds these episodes")
+    else:
+        print(f"logged {len(result.episodes)} episodes ({result.steps} steps) to {result.log}")
+    if report is not None:
+        report_build(report, cfg.out / "dataset")
+        return 1 if report.damage else 0
     return 0
 
 
@@ -207,15 +212,19 @@ def _dagger(args: argparse.Namespace) -> int:
 
 
 def _recover(args: argparse.Namespace) -> int:
-    from gymfg_il.collectors.commands import recover
+    from gymfg_il import cli
+    from gymfg_il.collectors.commands import RecoverConfig, recover
 
-    return recover(args.dir, args.callsign)
+    cfg = cli.build(RecoverConfig, args)
+    return recover(cfg.dir, cfg.callsign)
 
 
 def _replay(args: argparse.Namespace) -> int:
-    from gymfg_il.collectors.commands import replay
+    from gymfg_il import cli
+    from gymfg_il.collectors.commands import ReplayConfig, replay
 
-    return replay(args.log, args.episode, args.view)
+    cfg = cli.build(ReplayConfig, args)
+    return replay(cfg.log, cfg.episode, cfg.view)
 
 
 COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {

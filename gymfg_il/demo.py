@@ -122,7 +122,7 @@ def run(cfg: DemoConfig) -> int:
 
 
 def write_report(run: Path, policy: Path, rows: list[dict[str, object]], seconds: float) -> None:
-    from gymfg_il.evaluation.report import table
+    from gymfg_il.evaluation.report import ratio_line, table
 
     meta = json.loads((policy / "config.json").read_text())
     shutil.copy(policy / "loss.png", run / "loss.png")
@@ -139,11 +139,7 @@ def write_report(run: Path, policy: Path, rows: list[dict[str, object]], seconds
         table(rows),
         "```",
         "",
-        *[
-            f"- {r['agent']} / controller: return {r['return_ratio']:.1%}, success "
-            f"{r['success_ratio']:.1%}"
-            for r in rows[1:]
-        ],
+        *[f"- {ratio_line(r)}" for r in rows[1:]],
         "",
         "![loss](loss.png)",
         "",

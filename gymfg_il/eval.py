@@ -28,7 +28,7 @@ def _main(cfg: object, show_progress: bool) -> int:
     from gymfg_il import cli
     from gymfg_il.datasets.lerobot_api import hub_offline
     from gymfg_il.evaluation.config import EvalConfig, run_eval
-    from gymfg_il.evaluation.report import table
+    from gymfg_il.evaluation.report import ratio_line, table
 
     assert isinstance(cfg, EvalConfig)
     hub_offline()
@@ -54,10 +54,7 @@ def _main(cfg: object, show_progress: bool) -> int:
     )
     print(table(run.rows))
     for row in run.rows[1:]:
-        print(
-            f"\n{row['agent']} / controller: return {row['return_ratio']:.1%}, "
-            f"success {row['success_ratio']:.1%}"
-        )
+        print(f"\n{ratio_line(row)}")
     for path in run.written:
         print(f"{'rows' if path.suffix == '.json' else 'plot'} written to {path}")
     return 0

@@ -45,6 +45,11 @@ class ReplayConfig:
     episode: int | None = None
     view: list[int] = field(default_factory=list, metadata={"repeat": True})
 
+    def __post_init__(self) -> None:
+        bad = [p for p in self.view if not 0 < p < 65536]
+        if bad:
+            raise ConfigError(f"--view {bad[0]}: a UDP port is 1..65535")
+
 
 def report_build(report: BuildReport, root: Path) -> None:
     r = report

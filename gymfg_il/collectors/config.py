@@ -15,6 +15,7 @@ from typing import Any, Literal
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ
+from gymfg_il.typecheck import type_problems
 
 
 @dataclass
@@ -24,7 +25,8 @@ class CollectConfig:
     Attributes:
         kind: who flies: ``autopilot`` (the task's PID controller) or ``manual`` (a person).
         aircraft: JSBSim model (c172p, f15, A320, or any other JSBSim ships).
-        task: task family: altitude, roll, pitch, heading, airspeed, level.
+        task: task family: altitude, roll, pitch, heading, airspeed, sideslip (the rudder's
+            task), level.
         dynamic: moving targets instead of fixed ones.
         episodes: episodes to record (manual: 0 = until you quit).
         episode_time_s: seconds per episode.
@@ -63,6 +65,9 @@ class CollectConfig:
     joystick: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        typed = type_problems(self)
+        if typed:  # a recipe's `dynamic = "no"` must not pass as true
+            raise ConfigError(join_problems("collection config", typed))
         self.out = Path(self.out)
         problems = []
         if self.kind not in ("autopilot", "manual"):
@@ -85,6 +90,7 @@ class CollectConfig:
             isinstance(self.noise, (int, float)) and math.isfinite(self.noise) and self.noise >= 0
         ):
             problems.append(f"noise={self.noise!r} must be a number >= 0")
+        problems += [f"view port {p}: want 1..65535" for p in self.view if not 0 < p < 65536]
         if problems:
             raise ConfigError(join_problems("collection config", problems))
 

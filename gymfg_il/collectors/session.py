@@ -8,6 +8,7 @@ process as results arrive in seed order, so it is identical to a one-worker sess
 from __future__ import annotations
 
 import logging
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,9 +33,19 @@ __all__ = ["DATASET", "LOGS", "SessionResult", "check_appendable", "check_out_fo
 
 
 def check_out_folder(out: Path) -> None:
-    """``out`` must be new, empty, or a session folder (``logs/``, ``dataset/``, policies)."""
+    """``out`` must be new, empty, or a session folder (``logs/``, ``dataset/``, policies),
+    in a place this process may write to (checked before anything is flown)."""
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out {out} is a file; give a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".gymfg-write-check-{os.getpid()}"
+        probe.touch()
+        probe.unlink()
+    except OSError as err:
+        raise ConfigError(
+            f"--out {out}: cannot write there ({err.strerror}); give a folder you may write to"
+        ) from None
     if out.is_dir():
         foreign = sorted(
             p.name
@@ -75,9 +86,27 @@ def check_appendable(
         )
 
 
+def already_collected(out: Path, flight: FlightSpec, source: str, noise: float) -> set[int]:
+    """Seeds whose episode of this flight, source and noise the dataset at ``out`` holds
+    (collecting them again would only add copies)."""
+    root = out / DATASET
+    if not (root / "meta" / "info.json").is_file():
+        return set()
+    episodes = lr.open_metadata(root).episodes
+    need = ("gymfg/seed", "gymfg/spec", "gymfg/source", "gymfg/noise")
+    if episodes is None or not set(need) <= set(episodes.column_names):
+        return set()
+    rows = zip(*(episodes[c] for c in need), strict=True)
+    return {
+        int(seed)
+        for seed, spec, src, n in rows
+        if src == source and float(n) == float(noise) and FlightSpec.from_json(spec) == flight
+    }
+
+
 @dataclass
 class SessionResult:
-    log: Path
+    log: Path | None  # None when there was nothing to fly
     episodes: list[Episode]
 
     @property
@@ -108,6 +137,8 @@ def record_session(
     names = record["aircraft"]["ego"]["observation_names"]
     check_appendable(out, names, flight.agent_hz, flight)
     episodes: list[Episode] = []
+    if not seeds:
+        return SessionResult(None, episodes)
     flown = iter_many(flight, pilot, seeds, workers, expert=expert, noise=noise)
     with TrajectoryWriter(new_log_path(out, source), record) as writer:
         for i, episode in enumerate(flown):

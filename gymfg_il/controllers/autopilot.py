@@ -7,7 +7,7 @@ Loops (each a ``PID`` with explicit ``dt``):
 | elevator | pitch (damped by pitch rate) | climb rate -> pitch, altitude -> climb rate |
 | aileron | roll (damped by roll rate) | heading -> roll |
 | throttle | airspeed | |
-| rudder | sideslip -> 0 (coordinated flight) | |
+| rudder | sideslip -> 0 (coordinated flight), or to a target (a slip) | |
 
 ``Autopilot`` holds one target per axis (vertical: altitude, climb rate or pitch; lateral: roll
 or heading; speed: airspeed). Axes left without a target hold what they had at the first
@@ -38,6 +38,7 @@ class Targets:
     lateral: str = "roll"  # "roll" or "heading"
     lateral_source: str | float | None = 0.0
     speed_source: str | float | None = None
+    sideslip_source: str | float | None = None  # None: coordinated flight (zero sideslip)
 
 
 class Autopilot:
@@ -87,6 +88,7 @@ class Autopilot:
         self.roll_pid = PID(*g.roll)
         self.climb_pid = PID(*g.climb, out_min=-g.max_pitch_deg, out_max=g.max_pitch_deg)
         self.speed_pid = PID(*g.speed, out_min=0.0, out_max=1.0)
+        self.slip_pid = PID(*g.slip)
         self.start: list[float] | None = None
         self._last_heading_target: float | None = None
         self._last_altitude_target: float | None = None
@@ -95,7 +97,7 @@ class Autopilot:
         self._from_observation: dict[str, int] = {}
 
     def reset(self, seed: int | None = None) -> None:
-        for pid in (self.pitch_pid, self.roll_pid, self.climb_pid, self.speed_pid):
+        for pid in (self.pitch_pid, self.roll_pid, self.climb_pid, self.speed_pid, self.slip_pid):
             pid.reset()
         self._from_observation = {}
         self.start = None
@@ -198,7 +200,11 @@ class Autopilot:
         speed_target = self._value(obs, t.speed_source, "airspeed_kts")
         self._load_integral("speed", self.speed_pid, obs, speed_target - obs[i["airspeed_kts"]])
         throttle = self.speed_pid(speed_target, obs[i["airspeed_kts"]], dt)
-        rudder = max(-1.0, min(1.0, -g.sideslip * obs[i["beta_deg"]]))
+        if t.sideslip_source is None:  # coordinated flight: sideslip to zero
+            rudder = max(-1.0, min(1.0, -g.sideslip * obs[i["beta_deg"]]))
+        else:  # a slip: rudder to the sideslip target (more rudder, more sideslip)
+            slip_target = self._value(obs, t.sideslip_source, "beta_deg")
+            rudder = self.slip_pid(slip_target, obs[i["beta_deg"]], dt)
         return np.array([aileron, -nose_up, rudder, throttle])
 
 
@@ -219,6 +225,7 @@ def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0
             "roll": Targets(lateral="roll", lateral_source=source),
             "heading": Targets(lateral="heading", lateral_source=source),
             "airspeed": Targets(speed_source=source),
+            "sideslip": Targets(sideslip_source=source),
         }[key]
     elif isinstance(task, LevelFlightTask):
         targets = Targets(lateral="heading", lateral_source=None)

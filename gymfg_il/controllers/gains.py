@@ -24,7 +24,9 @@ class Gains:
         altitude_to_climb: climb-rate target (ft/s) per ft of altitude error.
         heading_to_roll: roll target (deg) per deg of heading error.
         speed: (kp, ki, kd) throttle from airspeed error (per kt).
-        sideslip: rudder per deg of sideslip (drives sideslip to zero).
+        sideslip: rudder per deg of sideslip (drives sideslip to zero in coordinated flight).
+        slip: (kp, ki, kd) rudder from the error to a sideslip target (kd per deg/s of yaw
+            rate), for the sideslip task.
         max_pitch_deg, max_roll_deg: attitude limits of the outer loops.
         max_climb_fps, max_descent_fps: climb-rate limits of the altitude loop.
     """
@@ -36,6 +38,7 @@ class Gains:
     heading_to_roll: float
     speed: tuple[float, float, float]
     sideslip: float
+    slip: tuple[float, float, float]
     max_pitch_deg: float
     max_roll_deg: float
     max_climb_fps: float
@@ -51,6 +54,7 @@ GAINS: dict[str, Gains] = {
         heading_to_roll=1.2,
         speed=(0.05, 0.01, 0.0),
         sideslip=0.05,
+        slip=(0.05, 0.05, 0.0),
         max_pitch_deg=15.0,
         max_roll_deg=25.0,
         max_climb_fps=15.0,
@@ -64,6 +68,7 @@ GAINS: dict[str, Gains] = {
         heading_to_roll=1.2,
         speed=(0.02, 0.004, 0.0),
         sideslip=0.05,
+        slip=(0.05, 0.05, 0.0),
         max_pitch_deg=15.0,
         max_roll_deg=30.0,
         max_climb_fps=40.0,
@@ -77,6 +82,7 @@ GAINS: dict[str, Gains] = {
         heading_to_roll=1.0,
         speed=(0.03, 0.006, 0.0),
         sideslip=0.05,
+        slip=(0.05, 0.05, 0.0),
         max_pitch_deg=12.0,
         max_roll_deg=25.0,
         max_climb_fps=30.0,

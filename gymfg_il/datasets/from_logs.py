@@ -22,6 +22,7 @@ import numpy as np
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.features import dataset_features
+from gymfg_il.datasets.health import dataset_problems
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import EmptyLog, Log, LoggedEpisode, read_log
 
@@ -69,6 +70,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "target": float(target) if target is not None else math.nan,
         "seed": int(start.get("seed", -1)),
         "source": str(start.get("source", log.session.get("source", ""))),
+        "noise": float(log.session.get("noise", 0.0)),
         "interventions": int(episode.steps[callsign].intervention.sum()),
         "iteration": int(start.get("iteration", 0)),
         "outcome": str(end.get("outcome", "")),
@@ -79,20 +81,13 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
 
 
 def _dataset_ok(root: Path) -> bool:
-    """Whether the dataset at ``root`` is whole: its metadata loads, its statistics and task
-    table are there, and its data files are readable parquet holding every frame."""
-    import pyarrow.parquet as pq
-
+    """Whether the dataset at ``root`` is whole (``health.dataset_problems``) and its
+    metadata loads with LeRobot."""
+    if dataset_problems(root):
+        return False
     try:
         meta = lr.open_metadata(root)
-        if meta.episodes is not None and len(meta.episodes) != meta.total_episodes:
-            return False
-        if not (root / "meta" / "stats.json").is_file() or meta.stats is None:
-            return False
-        if not (root / "meta" / "tasks.parquet").is_file():
-            return False
-        rows = sum(pq.ParquetFile(p).metadata.num_rows for p in (root / "data").rglob("*.parquet"))
-        return bool(rows == meta.total_frames)
+        return meta.episodes is None or len(meta.episodes) == meta.total_episodes
     except Exception:  # any failure to load means: rebuild from the logs
         return False
 

@@ -51,7 +51,9 @@ class OfflineEnv:
     every aircraft of the team has crashed, stalled or left the envelope (``info["reasons"]``
     says which and why); ``truncated`` is True at the time limit (the smallest
     ``episode_time_s`` among the teams). An aircraft that terminates stops being simulated,
-    its reward is 0 and its action is ignored from then on.
+    its reward is 0 and its action is ignored from then on; from the next step it is absent
+    from the others' ``opponent_states`` (``info["opponent_callsigns"]`` names the rows) and
+    from their rewards' ``ctx.targets``, as an online server drops a team that left.
     """
 
     def __init__(
@@ -132,7 +134,7 @@ class OfflineEnv:
             for agent in agents:
                 agent.reset(int(self._rng.integers(2**31)))
         self._done = False
-        return self._team_state(), self.world.opponent_states(self.team.name)
+        return self._team_state(), self.world.opponent_states(self.team.name, present_only=True)
 
     def step(
         self, team_actions: object
@@ -145,7 +147,7 @@ class OfflineEnv:
         own = team_controls(team_actions, team.callsigns)
         actions: list[Controls | None] = list(own)
         for other, agents in self.opponents:
-            opp_view = world.opponent_states(other.name)
+            opp_view = world.opponent_states(other.name, present_only=True)
             for slot, agent in zip(world.team_slots[other.name], agents, strict=True):
                 if slot.terminated:
                     actions.append(None)
@@ -163,11 +165,11 @@ class OfflineEnv:
             "time_s": world.steps * world.dt,
             "terminated": [s.terminated for s in slots],
             "reasons": {s.callsign: s.reason for s in world.slots if s.reason},
-            "opponent_callsigns": [s.callsign for s in world.opponents_of(team.name)],
+            "opponent_callsigns": [s.callsign for s in world.opponents_of(team.name, True)],
         }
         return (
             self._team_state(),
-            world.opponent_states(team.name),
+            world.opponent_states(team.name, present_only=True),
             rewards,
             terminated,
             truncated,

@@ -15,6 +15,7 @@ IDS: dict[str, str] = {
     "GymFG/Pitch-v0": "pitch",
     "GymFG/Heading-v0": "heading",
     "GymFG/Airspeed-v0": "airspeed",
+    "GymFG/Sideslip-v0": "sideslip",
     "GymFG/LevelFlight-v0": "level",
     "GymFG/Dummy-v0": "dummy",
 }

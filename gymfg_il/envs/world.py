@@ -60,6 +60,7 @@ class Slot:
         "action",
         "aircraft",
         "ctx",
+        "ended_at",
         "history",
         "index",
         "prev_action",
@@ -87,6 +88,7 @@ class Slot:
         self.reward = 0.0
         self.terminated = False
         self.reason: str | None = None
+        self.ended_at: int | None = None  # the step it terminated at
         self.history: deque[tuple[np.ndarray, np.ndarray]] = deque(
             maxlen=max(task.history_window, 1)
         )
@@ -97,8 +99,14 @@ class Slot:
             self.action,
             history=self.history,
         )
-        # (view to refresh, source slot, restricted to the opponent view?)
-        self.target_links: list[tuple[StateView, Slot, bool]] = []
+        # (callsign, view to refresh, source slot or None (seen from a server), restricted to
+        # the opponent view?)
+        self.target_links: list[tuple[str, StateView, Slot | None, bool]] = []
+
+    def present(self, step: int) -> bool:
+        """Whether it is still there to be seen at ``step`` (it crashed at this step or
+        flies on; from the next step on, a terminated aircraft is absent)."""
+        return self.ended_at is None or self.ended_at >= step
 
     @property
     def callsign(self) -> str:
@@ -163,7 +171,7 @@ class World:
                         view = self.external.setdefault(
                             target.callsign, StateView(np.full(len(view_names), np.nan), view_names)
                         )
-                        slot.ctx.targets[target.callsign] = view
+                        slot.target_links.append((target.callsign, view, None, True))
                         continue
                     if source is None or source.aircraft.model != target.model:
                         raise ConfigError(
@@ -176,8 +184,7 @@ class World:
                         if restricted
                         else StateView(source.state)
                     )
-                    slot.ctx.targets[target.callsign] = view
-                    slot.target_links.append((view, source, restricted))
+                    slot.target_links.append((target.callsign, view, source, restricted))
 
     # -- episode ------------------------------------------------------------------------
     def reset(
@@ -213,6 +220,7 @@ class World:
             slot.reward = 0.0
             slot.terminated = False
             slot.reason = None
+            slot.ended_at = None
             slot.history.clear()
         self.steps = 0
         self.started = True
@@ -260,8 +268,8 @@ class World:
         ctx.dt = self.dt
         task = slot.task
         ctx.target = task.target_value(self.steps)
-        for view, source, restricted in slot.target_links:
-            view.values = source.state[self.view_idx] if restricted else source.state
+        if slot.target_links:
+            self._show_targets(slot)
         reward = task.reward(ctx)
         if not math.isfinite(reward):
             raise ConfigError(
@@ -273,6 +281,21 @@ class World:
         if reason is not None:
             slot.terminated = True
             slot.reason = reason
+            slot.ended_at = self.steps
+
+    def _show_targets(self, slot: Slot) -> None:
+        """Fill ``ctx.targets`` with the reward targets that are there to be seen: an
+        aircraft that terminated before this step, or one the server does not show (it has
+        not joined, or it left), is absent from it: ``ctx.targets.get(callsign)`` is None."""
+        shown = slot.ctx.targets
+        shown.clear()
+        for callsign, view, source, restricted in slot.target_links:
+            if source is None:  # seen from the server: there while the server shows it
+                if np.isfinite(view.values).all():
+                    shown[callsign] = view
+            elif source.present(self.steps):
+                view.values = source.state[self.view_idx] if restricted else source.state
+                shown[callsign] = view
 
     # -- views --------------------------------------------------------------------------
     @property
@@ -282,12 +305,17 @@ class World:
     def observation(self, slot: Slot) -> np.ndarray:
         return slot.task.observe(slot.state, self.steps)
 
-    def opponents_of(self, team: str) -> list[Slot]:
-        return [s for s in self.slots if s.team != team]
+    def opponents_of(self, team: str, present_only: bool = False) -> list[Slot]:
+        """Every other team's aircraft (``present_only``: not those that terminated before
+        this step, as a server drops them)."""
+        return [
+            s for s in self.slots if s.team != team and (not present_only or s.present(self.steps))
+        ]
 
-    def opponent_states(self, team: str) -> np.ndarray:
-        """What ``team`` sees of every other team's aircraft: (n, len(opponent_view)) float64."""
-        rows = [s.state[self.view_idx] for s in self.slots if s.team != team]
+    def opponent_states(self, team: str, present_only: bool = False) -> np.ndarray:
+        """What ``team`` sees of other teams' aircraft: (n, len(opponent_view)) float64, in
+        the order of ``opponents_of``."""
+        rows = [s.state[self.view_idx] for s in self.opponents_of(team, present_only)]
         if not rows:
             return np.zeros((0, len(self.view_idx)))
         return np.stack(rows)

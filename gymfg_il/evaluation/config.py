@@ -16,7 +16,7 @@ from gymfg_il.evaluation.trace import Trace
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.workers import Workers
 
-TASKS = ("altitude", "roll", "pitch", "heading", "airspeed", "level")
+TASKS = ("altitude", "roll", "pitch", "heading", "airspeed", "sideslip", "level")
 
 
 @dataclass
@@ -27,8 +27,8 @@ class EvalConfig:
         policy: a trained policy (checkpoint folder) to fly beside the controller;
             repeatable. A policy flies its own flight (aircraft, task and options, agent
             rate, episode time, from its config.json) unless a flag below changes it.
-        task: task family: altitude, roll, pitch, heading, airspeed, level (default: the
-            policy's, else altitude).
+        task: task family: altitude, roll, pitch, heading, airspeed, sideslip (the rudder's
+            task), level (default: the policy's, else altitude).
         dynamic: moving targets (the family's dynamic task) instead of fixed ones (default:
             the policy's, else fixed).
         aircraft: JSBSim model: c172p, f15, A320 or any other JSBSim ships (default: the
@@ -103,8 +103,8 @@ def plan(cfg: EvalConfig) -> tuple[FlightSpec, dict[str, AgentSpec], list[str]]:
     )
     env = flight.make_env()
     try:
-        for meta in metas.values():
-            PolicyAgent(None, meta).check_observation(env.observation_names)
+        for path in metas:  # loaded whole now: a damaged policy fails before anything flies
+            PolicyAgent.load(path).check_observation(env.observation_names)
     finally:
         env.close()
     agents = {"controller": AgentSpec.controller()}

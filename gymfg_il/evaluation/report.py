@@ -34,3 +34,17 @@ def table(rows: Sequence[dict[str, object]]) -> str:
     lines = ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in cells]
     lines.insert(1, "-" * len(lines[0]))
     return "\n".join(lines)
+
+
+def _share(value: object, what: str) -> str:
+    if value is None:
+        return f"{what} n/a (the controller's is 0)"
+    return f"{what} {float(value):.1%}"  # type: ignore[arg-type]
+
+
+def ratio_line(row: dict[str, object]) -> str:
+    """``policy:P / controller: return 99.7%, success 100.0%`` for one row."""
+    return (
+        f"{row['agent']} / controller: {_share(row['return_ratio'], 'return')}, "
+        f"{_share(row['success_ratio'], 'success')}"
+    )

@@ -95,12 +95,13 @@ def flight_for(
 
 
 def add_ratios(rows: list[dict[str, Any]]) -> None:
-    """Each agent's mean return and success rate as a share of the controller's (first row)."""
+    """Each agent's mean return and success rate as a share of the controller's (first row);
+    None where the controller's is zero (no share to give)."""
     base = rows[0]
     for row in rows:
         for key, ratio in (("mean_return", "return_ratio"), ("success_rate", "success_ratio")):
             ref, value = float(base[key]), float(row[key])
-            row[ratio] = value / ref if ref else float("nan")
+            row[ratio] = value / ref if ref else None
 
 
 def evaluate(

@@ -14,6 +14,7 @@ from typing import Any, Literal
 import numpy as np
 
 from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.typecheck import type_problems
 
 DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
 log = logging.getLogger(__name__)
@@ -52,6 +53,9 @@ class TrainConfig:
     sequence_length: int = 32
 
     def __post_init__(self) -> None:
+        typed = type_problems(self)
+        if typed:
+            raise ConfigError(join_problems("train config", typed))
         self.dataset = Path(self.dataset)
         problems = []
         if self.policy not in ("mlp", "gru"):
@@ -60,6 +64,12 @@ class TrainConfig:
             problems.append("epochs and batch_size must be >= 1")
         if not (self.lr > 0 and math.isfinite(self.lr)):
             problems.append(f"lr={self.lr} must be a positive number")
+        if not (self.weight_decay >= 0 and math.isfinite(self.weight_decay)):
+            problems.append(f"weight_decay={self.weight_decay} must be a number >= 0")
+        if not self.hidden or min(self.hidden) < 1:
+            problems.append(f"hidden={self.hidden} must be widths >= 1")
+        if self.sequence_length < 2:
+            problems.append(f"sequence_length={self.sequence_length} must be >= 2")
         if not 0.0 <= self.val_fraction < 1.0:
             problems.append(f"val_fraction={self.val_fraction} must lie in [0, 1)")
         if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
@@ -101,6 +111,15 @@ def train_bc(
 
     device = resolve_device(cfg.device)
     frames = frames if frames is not None else load_frames(cfg.dataset)
+    flight, why = frames.flight()
+    if flight is None:
+        log.warning(
+            "the policy records no flight spec: %s; eval will need --task and --aircraft", why
+        )
+    label = flight.task_label if flight else "task"
+    name = f"bc-{label}-{flight.aircraft if flight else 'aircraft'}-{cfg.policy}"
+    out = Path(cfg.out) if cfg.out is not None else Path("policies") / name
+    _check_out(out)  # before training, not after
     train, val = split_by_episode(frames, cfg.val_fraction, cfg.seed)
     torch.manual_seed(cfg.seed)
     if cfg.policy == "gru":
@@ -135,14 +154,6 @@ def train_bc(
         if on_epoch is not None:
             on_epoch(epoch, train_loss[-1], val_loss[-1])
     seconds = time.perf_counter() - started
-    flight, why = frames.flight()
-    if flight is None:
-        log.warning(
-            "the policy records no flight spec: %s; eval will need --task and --aircraft", why
-        )
-    label = flight.task_label if flight else "task"
-    name = f"bc-{label}-{flight.aircraft if flight else 'aircraft'}-{cfg.policy}"
-    out = Path(cfg.out) if cfg.out is not None else Path("policies") / name
     meta = {
         "name": name,
         # what the policy flies: the whole spec, and its names for a reader of the file
@@ -171,6 +182,17 @@ def train_bc(
         json.dumps({"train_loss": train_loss, "val_loss": val_loss}, indent=1)
     )
     return TrainResult(out, train_loss, val_loss, seconds, len(train) * cfg.epochs, meta)
+
+
+def _check_out(out: Path) -> None:
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"--out {out} is a file; give a folder for the policy")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / ".write-check").touch()
+        (out / ".write-check").unlink()
+    except OSError as err:
+        raise ConfigError(f"--out {out}: cannot write there ({err.strerror})") from None
 
 
 def evaluate_loss(policy: Any, batches: Any) -> float:

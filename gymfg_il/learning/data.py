@@ -15,8 +15,9 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
+from gymfg_il.datasets.health import dataset_problems
 from gymfg_il.envs.flight import FlightSpec
-from gymfg_il.errors import ConfigError
+from gymfg_il.errors import ConfigError, join_problems
 
 
 @dataclass
@@ -89,10 +90,19 @@ def _column(table: Any, name: str) -> np.ndarray:
 def load_frames(root: Path) -> Frames:
     """Open the LeRobot dataset at ``root`` and take its frames into memory."""
     root = Path(root)
+    if not (root / "meta").is_dir() and (root / "dataset" / "meta").is_dir():
+        root = root / "dataset"  # a session folder: its dataset is inside
     if not (root / "meta" / "info.json").is_file():
         raise ConfigError(
             f"no LeRobot dataset at {root} (no meta/info.json); collect one with "
             "`python -m gymfg_il.collect autopilot --out DIR` and pass DIR/dataset"
+        )
+    problems = dataset_problems(root)
+    if problems:
+        raise ConfigError(
+            join_problems(f"the dataset at {root} is incomplete", problems)
+            + "\nRebuild it from its session's logs: python -m gymfg_il.collect recover "
+            + (str(root.parent) if (root.parent / "logs").is_dir() else "SESSION_DIR")
         )
     ds = lr.open_dataset(root)
     features = ds.meta.features

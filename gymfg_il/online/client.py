@@ -222,10 +222,15 @@ class OnlineEnv:
                 others[callsign] = np.asarray(values, dtype=np.float64)[self._pose_at]
         external = self.world.external  # opponents a reward targets
         if external:
+            shown = set()
             for callsign, _, values in rows:
                 view = external.get(callsign)
                 if view is not None:
                     view.values = np.asarray(values, dtype=np.float64)
+                    shown.add(callsign)
+            for callsign, view in external.items():  # not shown: absent from ctx.targets
+                if callsign not in shown:
+                    view.values = np.full(len(view.values), np.nan)
         if not rows:
             return np.zeros((0, len(self.view)))
         return np.array([r[2] for r in rows], dtype=np.float64)

@@ -76,7 +76,14 @@ def read_config(path: Path) -> dict[str, Any]:
             f"{path} is not a policy checkpoint (needs {CONFIG_FILE} and {WEIGHTS_FILE}); "
             "train one with `python -m gymfg_il.train bc`"
         )
-    data: dict[str, Any] = json.loads((path / CONFIG_FILE).read_text())
+    try:
+        data = json.loads((path / CONFIG_FILE).read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{path / CONFIG_FILE} is not valid JSON ({err}); train again") from None
+    need = ("type", "policy", "obs_stats", "action_stats")
+    missing = [k for k in need if not isinstance(data, dict) or k not in data]
+    if missing:
+        raise ConfigError(f"{path / CONFIG_FILE} is not a policy config (no {missing})")
     return data
 
 
@@ -85,11 +92,20 @@ def load_policy(path: Path, device: str = "cpu") -> tuple[Any, dict[str, Any]]:
     from safetensors.torch import load_file
 
     meta = read_config(path)
-    policy_fields = dict(meta["policy"])
-    kind = policy_fields.pop("type", meta["type"])
-    config = make_config(kind, **policy_fields)
-    obs = {k: np.array(v) for k, v in meta["obs_stats"].items()}
-    act = {k: np.array(v) for k, v in meta["action_stats"].items()}
-    policy = make_policy(config, obs, act)
-    policy.load_state_dict(load_file(str(Path(path) / WEIGHTS_FILE)))
+    try:
+        policy_fields = dict(meta["policy"])
+        kind = policy_fields.pop("type", meta["type"])
+        config = make_config(kind, **policy_fields)
+        obs = {k: np.array(v) for k, v in meta["obs_stats"].items()}
+        act = {k: np.array(v) for k, v in meta["action_stats"].items()}
+        policy = make_policy(config, obs, act)
+        policy.load_state_dict(load_file(str(Path(path) / WEIGHTS_FILE)))
+    except ConfigError:
+        raise
+    except Exception as err:  # safetensors, torch and the config raise many types
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise ConfigError(
+            f"the policy at {path} cannot be loaded ({first}); its {WEIGHTS_FILE} is damaged or "
+            f"does not match its {CONFIG_FILE}: train it again"
+        ) from None
     return policy.to(device).eval(), meta

@@ -82,13 +82,14 @@ def _reset(world: World, episode: LoggedEpisode) -> None:
 
 
 def _show(world: World, view: OpponentView) -> None:
-    """Give the world's external reward targets the values a logged view holds."""
-    for callsign, values in zip(view.callsigns, view.values, strict=True):
-        target = world.external.get(callsign)
-        if target is not None:
-            if target.names() != view.names:
-                target.rename(view.names)
-            target.values = values
+    """Give the world's external reward targets the values a logged view holds (NaN, that
+    is absent, for those it does not show)."""
+    shown = dict(zip(view.callsigns, view.values, strict=True))
+    for callsign, target in world.external.items():
+        if target.names() != view.names:
+            target.rename(view.names)
+        values = shown.get(callsign)
+        target.values = values if values is not None else np.full(len(view.names), np.nan)
 
 
 def replay_episode(

@@ -114,8 +114,9 @@ def team_views(
         if own is not None and team == own[0]:
             views[team] = OpponentView(list(own[1]), names, np.asarray(own[2], np.float64))
             continue
-        others = world.opponents_of(team)
-        views[team] = OpponentView([s.callsign for s in others], names, world.opponent_states(team))
+        others = world.opponents_of(team, present_only=True)
+        rows = world.opponent_states(team, present_only=True)
+        views[team] = OpponentView([s.callsign for s in others], names, rows)
     return views
 
 

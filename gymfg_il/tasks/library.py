@@ -36,6 +36,7 @@ from gymfg_il.tasks.targets import (
     HEADING,
     PITCH,
     ROLL,
+    SIDESLIP,
     SMOOTHNESS_WEIGHT,
     TargetFamily,
     TargetTask,
@@ -149,6 +150,21 @@ class ReachDynamicTargetAirspeedTask(TargetTask):
     __doc__ = _doc("Track an airspeed target that moves during the episode.", AIRSPEED, True, "kt")
 
 
+class ReachStaticTargetSideslipTask(TargetTask):
+    family = SIDESLIP
+    name = "sideslip"
+    __doc__ = _doc(
+        "Hold a fixed sideslip angle with the rudder (a slip), wings level.", SIDESLIP, False, "deg"
+    )
+
+
+class ReachDynamicTargetSideslipTask(TargetTask):
+    family = SIDESLIP
+    dynamic = True
+    name = "sideslip-dynamic"
+    __doc__ = _doc("Track a sideslip target that moves during the episode.", SIDESLIP, True, "deg")
+
+
 _ALT = INDEX["altitude_ft"]
 _HDG = INDEX["heading_deg"]
 _ROLL = INDEX["roll_deg"]
@@ -215,10 +231,13 @@ TASK_FAMILIES: dict[str, tuple[type[Task], type[Task]]] = {
     "pitch": (ReachStaticTargetPitchTask, ReachDynamicTargetPitchTask),
     "heading": (ReachStaticTargetHeadingTask, ReachDynamicTargetHeadingTask),
     "airspeed": (ReachStaticTargetAirspeedTask, ReachDynamicTargetAirspeedTask),
+    "sideslip": (ReachStaticTargetSideslipTask, ReachDynamicTargetSideslipTask),
     "level": (LevelFlightTask, LevelFlightTask),
     "dummy": (DummyTask, DummyTask),
 }
 assert set(FAMILIES) <= set(TASK_FAMILIES)
+# other names people look for a family by (the paper names the rudder's controller)
+TASK_ALIASES = {"rudder": "sideslip"}
 
 
 def task_class(name: str, dynamic: bool = False) -> type[Task]:
@@ -228,6 +247,7 @@ def task_class(name: str, dynamic: bool = False) -> type[Task]:
 
     if isinstance(name, str) and ":" in name:
         return _import_task(name)
+    name = TASK_ALIASES.get(name, name) if isinstance(name, str) else name
     try:
         static, moving = TASK_FAMILIES[name]
     except (KeyError, TypeError):

@@ -27,7 +27,10 @@ class RewardContext:
         prev_state: the state before it.
         action: the action applied at this step ``[aileron, elevator, rudder, throttle]``.
         prev_action: the action applied at the step before.
-        targets: callsign -> state of each aircraft in the team's reward targets.
+        targets: callsign -> state of each aircraft in the team's reward targets that is
+            there to be seen: one that terminated before this step, or an online opponent
+            the server does not show (not joined yet, or left), is absent, so a reward reads
+            ``ctx.targets.get(callsign)`` and decides what absence is worth.
         history: the last ``history_window`` (state, action) pairs before ``prev_state``,
             oldest first, as arrays in catalogue order (empty unless the task asks for it).
         target: the task's current target value, if it has one.

@@ -57,7 +57,11 @@ HEADING = TargetFamily(
     "heading", "heading_deg", True, (-90.0, 90.0), 10.0, 3.0, 1.0, True, ("heading_deg",)
 )
 AIRSPEED = TargetFamily("airspeed", "airspeed_kts", True, (-20.0, 20.0), 5.0, 3.0, 1.0)
-FAMILIES: dict[str, TargetFamily] = {f.key: f for f in (ALTITUDE, ROLL, PITCH, HEADING, AIRSPEED)}
+# the rudder's task: hold a sideslip angle (a slip), wings level
+SIDESLIP = TargetFamily("sideslip", "beta_deg", False, (-4.0, 4.0), 1.0, 0.5, 1.0)
+FAMILIES: dict[str, TargetFamily] = {
+    f.key: f for f in (ALTITUDE, ROLL, PITCH, HEADING, AIRSPEED, SIDESLIP)
+}
 
 SMOOTHNESS_WEIGHT = 0.05
 # the error integral observed by target tasks saturates at this many seconds of full error

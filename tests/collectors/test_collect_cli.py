@@ -152,3 +152,19 @@ def test_recipe_overrides_take_each_kind_its_own_flags(capsys):
     assert "apply to manual recipes" in capsys.readouterr().err
     assert collect.main([str(recipes / "manual-keyboard.toml"), "--noise", "0.1"]) == 2
     assert "apply to autopilot recipes" in capsys.readouterr().err
+
+
+def test_running_a_recipe_again_remakes_its_dataset_instead_of_doubling_it(tmp_path, capsys):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    recipe = tmp_path / "r.toml"
+    out = tmp_path / "s"
+    recipe.write_text(
+        f'[collector]\ntask = "roll"\nepisodes = 2\nepisode_time_s = 3.0\nout = "{out}"\n'
+    )
+    assert collect.main([str(recipe), "--no-progress"]) == 0
+    assert collect.main([str(recipe), "--no-progress"]) == 0
+    assert "nothing to fly" in capsys.readouterr().out
+    assert LeRobotDataset("x/y", root=tmp_path / "s" / "dataset").num_episodes == 2
+    assert collect.main([str(recipe), "--episodes", "3", "--no-progress"]) == 0  # one more
+    assert LeRobotDataset("x/y", root=tmp_path / "s" / "dataset").num_episodes == 3

@@ -168,6 +168,8 @@ def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
     policy.mkdir()
     (policy / "model.safetensors").write_bytes(b"not read")
     spec = FlightSpec.solo("c172p", "altitude", agent_hz=10)
-    (policy / "config.json").write_text(json.dumps({"spec": spec.to_dict(), "fps": 10}))
+    stats = {"mean": [0.0], "std": [1.0]}
+    config = {"type": "mlp", "policy": {}, "obs_stats": stats, "action_stats": stats}
+    (policy / "config.json").write_text(json.dumps({**config, "spec": spec.to_dict(), "fps": 10}))
     with pytest.raises(ConfigError, match=r"trained at 10 Hz.*at 30 Hz"):
         ManualSession(SPEC, tmp_path / "out", assist=str(policy), realtime=False)

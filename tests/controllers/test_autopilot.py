@@ -89,3 +89,19 @@ def test_labels_from_the_observed_integral_depend_on_the_observation_alone():
             out.append(pilot.act(nxt)[0])
     assert labels[0] == pytest.approx(labels[1], abs=1e-9)
     assert bumpless[1] - bumpless[0] == pytest.approx(0.8, abs=1e-6)
+
+
+@pytest.mark.parametrize("model", ["c172p", "f15", "A320"])
+@pytest.mark.parametrize("target", [4.0, -4.0])
+def test_the_rudder_holds_a_sideslip_target(model, target):
+    errors = fly("sideslip", model, target, seconds=60)
+    assert errors[0] > 3.5  # from coordinated flight into a slip
+    assert errors[-400:].max() < 0.5  # held for the last 40 s, wings level
+
+
+def test_the_rudder_task_is_found_by_the_papers_name_and_its_dynamic_one_is_tracked():
+    from gymfg_il.tasks import ReachStaticTargetSideslipTask, task_class
+
+    assert task_class("rudder") is ReachStaticTargetSideslipTask
+    errors = fly("sideslip", "c172p", None, seconds=60, dynamic=True)
+    assert errors[100:].max() < 1.0

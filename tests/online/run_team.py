@@ -21,8 +21,8 @@ class ChaseTask(DummyTask):
     """Rewarded for closing on blue-1, an opponent seen only through the server."""
 
     def task_reward(self, ctx):
-        blue = ctx.targets["blue-1"]
-        return -geometry.distance_ft(ctx.state, blue) / 1e4
+        blue = ctx.targets.get("blue-1")  # absent until blue joins, and after it leaves
+        return -1.0 if blue is None else -geometry.distance_ft(ctx.state, blue) / 1e4
 
 
 def teams(seconds: float) -> dict[str, Team]:

@@ -1,0 +1,155 @@
+"""Bad input to the command lines gets one clear line and exit status 2, never a traceback
+(red-team findings: each case below raised a traceback before)."""
+
+import shutil
+import socket
+from pathlib import Path
+
+import pytest
+
+from gymfg_il import collect, serve, train
+from gymfg_il import eval as evaluate
+
+SAMPLE = Path(__file__).resolve().parents[1] / "datasets/sample-altitude-c172p/dataset"
+
+
+def one_error(capsys, *needles):
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and err.startswith("error: "), err
+    for needle in needles:
+        assert needle in err, err
+
+
+@pytest.mark.parametrize(
+    "line, needle",
+    [
+        ('task_kwargs = "x"', "task_kwargs='x': want dict"),
+        ("out = 5", "out=5: want Path"),
+        ('dynamic = "no"', "dynamic='no': want bool"),
+        ('episodes = "3"', "episodes='3': want int"),
+    ],
+)
+def test_recipe_values_of_the_wrong_type(tmp_path, capsys, line, needle):
+    recipe = tmp_path / "r.toml"
+    recipe.write_text(f"[collector]\n{line}\n")
+    assert collect.main([str(recipe), "--no-progress"]) == 2
+    one_error(capsys, needle)
+
+
+def test_collect_out_where_nothing_can_be_written(tmp_path, capsys):
+    (tmp_path / "a-file").write_text("")
+    argv = ["autopilot", "--out", str(tmp_path / "a-file" / "x"), "--episodes", "1"]
+    assert collect.main([*argv, "--no-progress"]) == 2
+    one_error(capsys, "cannot write there")
+
+
+def damaged(tmp_path, how):
+    root = tmp_path / "dataset"
+    shutil.copytree(SAMPLE, root)
+    how(root)
+    return root
+
+
+def truncate(path):
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 3])
+
+
+@pytest.mark.parametrize(
+    "how, needle",
+    [
+        (lambda r: truncate(next((r / "data").rglob("*.parquet"))), "not readable parquet"),
+        (lambda r: next((r / "data").rglob("*.parquet")).unlink(), "no data files"),
+        (lambda r: (r / "meta" / "tasks.parquet").unlink(), "tasks.parquet is missing"),
+        (lambda r: (r / "meta" / "info.json").write_text("{garbled"), "info.json is not valid"),
+        (lambda r: (r / "meta" / "stats.json").write_text("{garbled"), "stats.json is not valid"),
+        (lambda r: (r / "meta" / "stats.json").unlink(), "stats.json is missing"),
+    ],
+)
+def test_train_on_an_incomplete_dataset_says_what_is_missing(tmp_path, capsys, how, needle):
+    root = damaged(tmp_path, how)
+    argv = ["bc", "--dataset", str(root), "--epochs", "1", "--out", str(tmp_path / "p")]
+    assert train.main([*argv, "--no-progress"]) == 2
+    one_error(capsys, "is incomplete", needle)
+
+
+def test_train_refuses_a_bad_out_and_nan_before_training(tmp_path, capsys):
+    (tmp_path / "a-file").write_text("")
+    base = ["bc", "--dataset", str(SAMPLE), "--epochs", "1", "--no-progress"]
+    assert train.main([*base, "--out", str(tmp_path / "a-file")]) == 2
+    one_error(capsys, "is a file")
+    assert train.main([*base, "--weight-decay", "nan", "--out", str(tmp_path / "p")]) == 2
+    one_error(capsys, "weight_decay=nan")
+    assert not (tmp_path / "p").exists()
+
+
+def test_train_takes_a_session_folder_for_its_dataset(tmp_path):
+    session = tmp_path / "session"
+    shutil.copytree(SAMPLE, session / "dataset")
+    argv = ["bc", "--dataset", str(session), "--epochs", "1", "--out", str(tmp_path / "p")]
+    assert train.main([*argv, "--no-progress"]) == 0
+
+
+def resize(config):
+    """The config of another network than the weights hold."""
+    text = config.read_text()
+    config.write_text(text.replace('"hidden": [\n      32', '"hidden": [\n      64'))
+
+
+@pytest.fixture(scope="module")
+def policy(tmp_path_factory):
+    out = tmp_path_factory.mktemp("policy")
+    argv = ["bc", "--dataset", str(SAMPLE), "--epochs", "1", "--hidden", "32", "--out", str(out)]
+    assert train.main([*argv, "--no-progress"]) == 0
+    return out
+
+
+@pytest.mark.parametrize(
+    "damage, needle",
+    [
+        (lambda p: (p / "config.json").write_text("{garbled"), "is not valid JSON"),
+        (lambda p: (p / "config.json").write_text(""), "is not valid JSON"),
+        (lambda p: (p / "model.safetensors").write_bytes(b"garbage"), "cannot be loaded"),
+        (lambda p: truncate(p / "model.safetensors"), "cannot be loaded"),
+        (
+            lambda p: (p / "config.json").write_text(
+                (p / "config.json")
+                .read_text()
+                .replace('"hidden": [\n      32', '"hidden": [\n      64')
+            ),
+            "does not match",
+        ),
+    ],
+)
+def test_eval_checks_a_policy_before_anything_flies(policy, tmp_path, capsys, damage, needle):
+    broken = tmp_path / "broken"
+    shutil.copytree(policy, broken)
+    damage(broken)
+    assert evaluate.main(["--policy", str(broken), "--episodes", "1", "--no-progress"]) == 2
+    one_error(capsys, needle)
+
+
+def test_serve_and_replay_refuse_impossible_ports_and_addresses(capsys):
+    for argv in (
+        ["--port", "99999"],
+        ["--port", "-1"],
+        ["--bind", "10.255.255.1", "--secret", "x"],
+    ):
+        assert serve.main(argv) == 2
+        one_error(capsys)
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        assert serve.main(["--port", str(taken.getsockname()[1])]) == 2
+        one_error(capsys, "cannot listen")
+    assert collect.main(["replay", "nowhere", "--view", "99999"]) == 2
+    one_error(capsys, "--view 99999")
+
+
+def test_a_zero_share_is_not_a_nan_percent():
+    from gymfg_il.evaluation.report import ratio_line
+
+    row = {"agent": "policy:p", "return_ratio": 0.5, "success_ratio": None}
+    assert (
+        ratio_line(row)
+        == "policy:p / controller: return 50.0%, success n/a (the controller's is 0)"
+    )
