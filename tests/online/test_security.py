@@ -53,8 +53,8 @@ def team(name, seconds=60.0):
     return Team(name, [(c172p(f"{name}-1"), DummyTask)], episode_time_s=seconds)
 
 
-def fly(address, name, steps, token="", out=None):
-    env = OnlineEnv(address, token=token, timeout_s=20)
+def fly(address, name, steps, token="", out=None, timeout_s=20.0):
+    env = OnlineEnv(address, token=token, timeout_s=timeout_s)
     try:
         env.reset(team(name), seed=0)
         for _ in range(steps):
@@ -166,3 +166,20 @@ def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve):
     assert re.search(r"refused \d+ more messages in the last \d+ s \(full: \d+\)", log)
     sock.close(0)
     ctx.term()
+
+
+def test_a_team_waiting_for_the_others_hears_why_instead_of_timing_out(serve, caplog):
+    import logging
+
+    address, *_ = serve("--mode", "fixed", "--teams", "2")
+    out = {}
+    caplog.set_level(logging.WARNING, logger="gymfg_il.online.client")
+    # red gives up after 1 s of silence, and waits 2.5 s for blue: the server's wait
+    # messages keep it waiting, and say what for
+    first = threading.Thread(target=fly, args=(address, "red", 3, "", out, 1.0))
+    first.start()
+    time.sleep(2.5)
+    assert "waiting for 1 more team to join" in caplog.text and out == {}
+    fly(address, "blue", 3, "", out)
+    first.join(30)
+    assert out == {"red": 3, "blue": 3}
