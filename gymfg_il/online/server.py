@@ -288,7 +288,7 @@ class StateServer:
         active = [t for t in self.teams.values() if t.active]
         waiting = [t for t in active if t.report is not None]
         if self.config.mode == "fixed" and not self.running:
-            if waiting and now - self._paused_notice > 1.0:
+            if waiting and now - self._paused_notice > 0.5:
                 self._tell_waiting(active)
             return
         if not waiting:
@@ -308,7 +308,7 @@ class StateServer:
             self._maybe_broadcast()
         elif self.config.on_stall == "end":
             self._broadcast(waiting, reason=f"team {names} stopped reporting")
-        elif now - self._paused_notice > 1.0:
+        elif now - self._paused_notice > 0.5:
             self._paused_notice = now
             for t in waiting:
                 self._send(t.identity, {"type": "wait", "reason": f"paused: waiting for {names}"})

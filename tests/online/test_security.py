@@ -174,11 +174,11 @@ def test_a_team_waiting_for_the_others_hears_why_instead_of_timing_out(serve, ca
     address, *_ = serve("--mode", "fixed", "--teams", "2")
     out = {}
     caplog.set_level(logging.WARNING, logger="gymfg_il.online.client")
-    # red gives up after 1 s of silence, and waits 2.5 s for blue: the server's wait
-    # messages keep it waiting, and say what for
-    first = threading.Thread(target=fly, args=(address, "red", 3, "", out, 1.0))
+    # red gives up after 1.5 s of silence, and waits 3.5 s for blue: the server's wait
+    # messages (every half second) keep it waiting, and say what for
+    first = threading.Thread(target=fly, args=(address, "red", 3, "", out, 1.5))
     first.start()
-    time.sleep(2.5)
+    time.sleep(3.5)
     assert "waiting for 1 more team to join" in caplog.text and out == {}
     fly(address, "blue", 3, "", out)
     first.join(30)
