@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.manual.pfd import PrimaryFlightDisplay
+
 BG, FG, DIM = (18, 22, 30), (225, 230, 240), (120, 130, 150)
 ACCENT, RED, GREEN, AMBER = (90, 170, 255), (235, 80, 80), (90, 200, 120), (240, 180, 60)
 
@@ -49,6 +51,7 @@ class ControlsGUI:
         self.small = pygame.font.Font(None, 20)
         self.big = pygame.font.Font(None, 40)
         self._cache: dict[tuple[str, tuple[int, int, int], int], Any] = {}
+        self.pfd = PrimaryFlightDisplay(pygame, (self.small, self.big))
 
     def _text(
         self, text: str, pos: tuple[int, int], color: tuple[int, int, int] = FG, font: Any = None
@@ -98,19 +101,21 @@ class ControlsGUI:
         )
         # target vs actual
         if f.target is not None and f.actual is not None:
-            self._text(f.target_name, (372, 60), DIM, self.small)
+            self._text(f.target_name, (372, 50), DIM, self.small)
             err = f.target - f.actual
-            self._text(f"target {f.target:9.1f}", (372, 80), ACCENT, self.big)
-            self._text(f"actual {f.actual:9.1f}", (372, 116), FG, self.big)
-            self._text(
-                f"error  {err:+9.1f}", (372, 152), AMBER if abs(err) > 1 else GREEN, self.big
-            )
-        # state variables: names aligned, values aligned
-        y = 200
+            self._text(f"target {f.target:8.1f}", (372, 66), ACCENT, self.font)
+            self._text(f"actual {f.actual:8.1f}", (560, 66), FG, self.font)
+            self._text(f"error {err:+8.1f}", (740, 66), AMBER if abs(err) > 1 else GREEN, self.font)
+        # the primary flight display, the target a magenta bug on its instrument
+        values = {name: value for name, (value, _) in f.variables.items()}
+        target_var = f.target_name.split(" ")[0] if f.target_name else None
+        self.pfd.draw(s, pg.Rect(430, 100, 440, 290), values, target_var, f.target)
+        # state variables under the stick: names aligned, values aligned
+        y = 404
         for name, (value, unit) in f.variables.items():
-            self._text(name, (372, y), DIM, self.small)
-            self._text(f"{value:12.3f} {unit}", (560, y), FG, self.small)
-            y += 20
+            self._text(name, (40, y), DIM, self.small)
+            self._text(f"{value:12.3f} {unit}", (200, y), FG, self.small)
+            y += 18
         if f.message:
             self._text(f.message, (40, self.size[1] - 34), AMBER)
         self._text("H: help", (self.size[0] - 80, self.size[1] - 30), DIM, self.small)
