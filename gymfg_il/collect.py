@@ -21,7 +21,7 @@ from pathlib import Path
 EPILOG = __doc__.split("\n\n", 1)[1]
 FLIGHT = ("aircraft", "task", "dynamic", "episode_time_s", "seed")
 AUTOPILOT = (*FLIGHT, "episodes", "agent_hz", "noise", "out")
-MANUAL = (*FLIGHT, "device", "agent_hz", "episodes", "assist", "out", "view")
+MANUAL = (*FLIGHT, "device", "agent_hz", "episodes", "assist", "out", "view", "pilot", "skill")
 RECIPE = tuple(dict.fromkeys(AUTOPILOT + MANUAL))
 
 
@@ -169,10 +169,24 @@ def _manual(args: argparse.Namespace) -> int:
 
 
 def _fly_by_hand(cfg: object) -> int:
+    import os
+
     from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.collectors.manual import ManualSession
 
     assert isinstance(cfg, CollectConfig)
+    synthetic: dict[str, object] = {}
+    if cfg.pilot == "synthetic":  # headless, as fast as the machine allows
+        from gymfg_il.collectors.synthetic import SyntheticDriver
+
+        os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+        synthetic = {
+            "on_frame": SyntheticDriver(cfg.skill),
+            "realtime": False,
+            "source": "synthetic",
+            "draw": False,
+            "build_each": False,
+        }
     session = ManualSession(
         cfg.flight(),
         cfg.out,
@@ -182,6 +196,7 @@ def _fly_by_hand(cfg: object) -> int:
         cfg.seed,
         cfg.episodes,
         views=tuple(cfg.view),
+        **synthetic,  # type: ignore[arg-type]
     )
     stats = session.run()
     print(

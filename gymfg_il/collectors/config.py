@@ -41,6 +41,10 @@ class CollectConfig:
             takes over (T); the person's frames are flagged as interventions.
         view: manual only: UDP ports of FlightGear out-the-window views (repeatable; see
             gymfg_il.viz.flightgear).
+        pilot: manual only: who is at the controls: a person, or the synthetic pilot (a model
+            of a person flying through the same keyboard, joystick or mouse; it runs
+            headless and as fast as the machine allows; its episodes are source=synthetic).
+        skill: manual only: the synthetic pilot's level, 0 (a novice) to 1 (an ace).
         keyboard: manual only: key bindings (see ``manual.bindings.KeyboardBindings``).
         mouse: manual only: mouse bindings (``MouseBindings``).
         joystick: manual only: joystick axes, dead zones, expo, buttons (``JoystickBindings``).
@@ -60,6 +64,8 @@ class CollectConfig:
     device: Literal["keyboard", "mouse", "joystick"] = "keyboard"
     assist: str | None = None
     view: list[int] = field(default_factory=list, metadata={"repeat": True})
+    pilot: Literal["person", "synthetic"] = "person"
+    skill: float = 0.7
     keyboard: dict[str, Any] = field(default_factory=dict)
     mouse: dict[str, Any] = field(default_factory=dict)
     joystick: dict[str, Any] = field(default_factory=dict)
@@ -83,7 +89,8 @@ class CollectConfig:
                 self.flight()
             except ConfigError as err:
                 problems.append(str(err))
-        least = 0 if self.kind == "manual" else 1  # a person may fly until they quit
+        # a person may fly until they quit; the synthetic pilot flies as many as asked
+        least = 0 if self.kind == "manual" and self.pilot == "person" else 1
         if not isinstance(self.episodes, int) or self.episodes < least:
             problems.append(f"episodes={self.episodes!r} must be an integer >= {least}")
         if not (
@@ -91,6 +98,8 @@ class CollectConfig:
         ):
             problems.append(f"noise={self.noise!r} must be a number >= 0")
         problems += [f"view port {p}: want 1..65535" for p in self.view if not 0 < p < 65536]
+        if not 0.0 <= self.skill <= 1.0:
+            problems.append(f"skill={self.skill}: want 0 (a novice) .. 1 (an ace)")
         if problems:
             raise ConfigError(join_problems("collection config", problems))
 

@@ -123,8 +123,14 @@ class ManualSession:
         seed: seed of the first episode (a discarded episode is flown again with its seed).
         max_episodes: stop after this many saved episodes (0 = until quit).
         realtime: pace frames to the wall clock at the env's rate.
-        on_frame: called at the start of each frame (tests inject events with it).
+        on_frame: called at the start of each frame (tests and the synthetic pilot inject
+            events with it).
         views: FlightGear UDP ports showing the aircraft (out-the-window views).
+        source: what the dataset calls the pilot (default: human, or ASSIST+human).
+        draw: draw the window every frame (a headless synthetic pilot needs no pictures).
+        build_each: bring the dataset up to date after every saved episode (a person's
+            session, so that quitting loses nothing); else once, at the end (the log keeps
+            every episode durable either way).
     """
 
     def __init__(
@@ -139,6 +145,9 @@ class ManualSession:
         realtime: bool = True,
         on_frame: Callable[[int, ManualSession], None] | None = None,
         views: tuple[int, ...] = (),
+        source: str | None = None,
+        draw: bool = True,
+        build_each: bool = True,
     ) -> None:
         bindings = bindings or {}
         out = Path(out)
@@ -168,7 +177,9 @@ class ManualSession:
             assistant = spec.make(self.env)
         self.pilot = Takeover(self.human, assistant)
         self.rollout = Rollout(self.env, [self.pilot])
-        self.source = "human" if assist is None else f"{self.assist_name}+human"
+        person = source or "human"
+        self.source = person if assist is None else f"{self.assist_name}+{person}"
+        self.draw, self.build_each = draw, build_each
         self.help = help_lines(device, self.kb)
         title = f"GymFG-IL: {flight.task_label} on {self.env.aircraft.model}"
         self.gui = ControlsGUI(title=title)
@@ -187,6 +198,11 @@ class ManualSession:
     def human_flies(self) -> bool:
         return self.pilot.human_flies
 
+    @property
+    def observation(self) -> np.ndarray:
+        """What the aircraft's pilot chooses the next action from."""
+        return self.rollout.current[0]
+
     # -- episodes --------------------------------------------------------------------------
     def _writer(self) -> TrajectoryWriter:
         if self.writer is None:
@@ -204,7 +220,8 @@ class ManualSession:
     def _finish(self, outcome: str) -> None:
         writer = self._writer()
         writer.end_episode(outcome=outcome, steps=self.step_count, interventions=self.interventions)
-        self.updater.request()  # the dataset follows in a helper process, off the GIL
+        if self.build_each:
+            self.updater.request()  # the dataset follows in a helper process, off the GIL
         self.stats.saved += 1
         self.episode += 1
         self.next_seed += 1
@@ -314,7 +331,8 @@ class ManualSession:
                 if running and self.state == "recording":
                     self._step()
                 self.updater.poll()
-                self._draw()
+                if self.draw:
+                    self._draw()
                 frame += 1
                 self.stats.frames = frame
                 if self.max_episodes and self.stats.saved >= self.max_episodes:
@@ -335,6 +353,8 @@ class ManualSession:
             self.writer = None
         self.env.close()
         self.gui.close()
+        if not self.build_each and self.stats.saved:
+            self.updater.request()
         if self.updater.close():
             self.stats.dataset = self.out / DATASET
 

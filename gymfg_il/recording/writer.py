@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 import numpy as np
+import orjson
 from mcap.writer import CompressionType, IndexType, Writer
 
 from gymfg_il.recording import schemas
@@ -123,7 +124,7 @@ class TrajectoryWriter:
         self._writer.add_message(
             channel,
             log_time=self._clock_ns,
-            data=json.dumps(message).encode(),
+            data=orjson.dumps(message, option=orjson.OPT_SERIALIZE_NUMPY),
             publish_time=self._clock_ns,
             sequence=self._sequence,
         )

@@ -13,10 +13,13 @@ from gymfg_il.envs.single import AircraftEnv
 
 @dataclass(frozen=True)
 class AgentSpec:
-    """``AgentSpec.controller()`` or ``AgentSpec.policy(path)``."""
+    """``AgentSpec.controller()``, ``AgentSpec.policy(path)`` or
+    ``AgentSpec.synthetic(device, skill)`` (the synthetic pilot at a ManualController)."""
 
     kind: str
     path: Path | None = None
+    device: str = "keyboard"
+    skill: float = 0.7
 
     @classmethod
     def controller(cls) -> AgentSpec:
@@ -25,6 +28,10 @@ class AgentSpec:
     @classmethod
     def policy(cls, path: Path) -> AgentSpec:
         return cls("policy", Path(path))
+
+    @classmethod
+    def synthetic(cls, device: str = "keyboard", skill: float = 0.7) -> AgentSpec:
+        return cls("synthetic", None, device, skill)
 
     def key(self) -> str:
         """What a worker's cache knows this agent by: its spec, and for a checkpoint the
@@ -50,12 +57,20 @@ class AgentSpec:
         return read_config(self.path)
 
     def make(self, env: AircraftEnv) -> Agent:
-        if self.kind == "controller":
+        if self.kind in ("controller", "synthetic"):
             from gymfg_il.controllers.autopilot import controller_for
 
-            return controller_for(
+            pilot = controller_for(
                 env.task, env.aircraft.model, env.dt, env.aircraft.profile.cruise_throttle
             )
+            if self.kind == "controller":
+                return pilot
+            from gymfg_il.manual.controller import ManualController
+            from gymfg_il.manual.synthetic import PilotAgent, SyntheticPilot
+
+            throttle = env.aircraft.profile.cruise_throttle
+            human = ManualController(self.device, throttle=throttle)
+            return PilotAgent(SyntheticPilot(self.device, pilot, env.dt, self.skill), human)
         from gymfg_il.policies.agent import PolicyAgent
 
         assert self.path is not None

@@ -237,6 +237,11 @@ class Rollout:
         return tick
 
     @property
+    def current(self) -> list[np.ndarray]:
+        """The observations the pilots choose the next actions from (roster order)."""
+        return self._obs
+
+    @property
     def observations(self) -> dict[str, np.ndarray]:
         """Every aircraft's observation after the last step."""
         return self._after

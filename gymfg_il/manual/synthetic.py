@@ -1,0 +1,275 @@
+"""A synthetic human pilot: a model of a person flying through the real ManualController.
+
+It decides, frame by frame, the pygame events a person at the controls would produce: keys
+pressed and released, joystick axes moved, the mouse dragged. What it wants to do comes from
+the task's autopilot (its "intent": a competent pilot knows what the aircraft needs); how it
+gets there is human:
+
+- it reacts to what it saw ``reaction_s`` ago, and reads the instruments imprecisely;
+- on the keyboard it can only hold keys: it presses one when the stick is off what it wants by
+  more than its ``deadband``, and lets go only once the stick has passed the mark by its
+  ``overshoot`` (over-corrections), while the controller's centring pulls the stick back;
+- a joystick or mouse hand shakes (``tremor``) and a stick reads in steps (``quantum``);
+- now and then its attention lapses: for ``lapse_s`` it lets go of the keys and holds still.
+
+``Skill.of(level)`` sets all of these from one number, 0 (a novice) to 1 (an ace). The same
+seed makes the same pilot make the same mistakes, so its demonstrations reproduce.
+
+It flies through the real session loop (``collect manual --pilot synthetic``: its events go
+into pygame's queue) or as an Agent (``PilotAgent``: its events go straight to a
+ManualController), so evaluation can score it beside the controller and the policies.
+"""
+
+from __future__ import annotations
+
+import collections
+import functools
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.controllers.agent import Agent
+from gymfg_il.errors import ConfigError
+from gymfg_il.manual.bindings import JoystickBindings, KeyboardBindings, MouseBindings
+from gymfg_il.manual.controller import DEVICES, ManualController
+from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
+
+CONTROLS = ("aileron", "elevator", "rudder", "throttle")
+
+
+@dataclass(frozen=True)
+class Skill:
+    """How a synthetic pilot flies (see the module docstring).
+
+    Attributes:
+        reaction_s: how long after something happens the pilot responds to it.
+        perception: std of its reading error, as a share of each instrument's value change
+            over one second (0 reads perfectly).
+        deadband: stick error it lets pass before correcting (keyboard), control units.
+        overshoot: how far past the wanted position a key is held (keyboard).
+        tremor: std of its hand's shake on a joystick or mouse, control units.
+        quantum: the stick's resolution, control units.
+        lapse_per_min: how often its attention lapses.
+        lapse_s: how long a lapse lasts.
+    """
+
+    reaction_s: float
+    perception: float
+    deadband: float
+    overshoot: float
+    tremor: float
+    quantum: float
+    lapse_per_min: float
+    lapse_s: float
+
+    @classmethod
+    def of(cls, level: float) -> Skill:
+        """A pilot of ``level`` in [0, 1]: 0 a novice, 1 an ace."""
+        if not (isinstance(level, (int, float)) and 0.0 <= level <= 1.0):
+            raise ConfigError(f"skill={level!r} must lie in [0, 1] (0 a novice, 1 an ace)")
+        x = float(level)
+        return cls(
+            reaction_s=0.5 - 0.35 * x,
+            perception=0.3 * (1.0 - x),
+            deadband=0.06 - 0.04 * x,
+            overshoot=0.03 - 0.02 * x,
+            tremor=0.03 * (1.0 - x) + 0.003,
+            quantum=1.0 / 128.0,
+            lapse_per_min=4.0 * (1.0 - x),
+            lapse_s=1.5 - x,
+        )
+
+
+def _event(kind: str, **fields: Any) -> Any:
+    import pygame
+
+    return pygame.event.Event(getattr(pygame, kind), **fields)
+
+
+@functools.cache
+def key_codes() -> dict[str, int]:
+    """pygame's key code of each key name (``pygame.key.key_code`` wants pygame.init())."""
+    import pygame
+
+    codes = (getattr(pygame, n) for n in dir(pygame) if n.startswith("K_"))
+    return {pygame.key.name(code): code for code in codes}
+
+
+class SyntheticPilot:
+    """The events a person would produce at the controls (see the module docstring).
+
+    Args:
+        device: keyboard, joystick or mouse.
+        intent: what the pilot wants the controls to be (the task's autopilot).
+        dt: seconds per frame.
+        skill: ``Skill`` or a level in [0, 1].
+        keyboard, mouse, joystick: the session's bindings (which keys, axes, spans).
+        window_size: the window the mouse stick is centred in.
+        seed: the pilot's own randomness (reading errors, tremor, lapses).
+    """
+
+    def __init__(
+        self,
+        device: str,
+        intent: Agent,
+        dt: float,
+        skill: Skill | float = 0.7,
+        keyboard: KeyboardBindings | None = None,
+        mouse: MouseBindings | None = None,
+        joystick: JoystickBindings | None = None,
+        window_size: tuple[int, int] = (900, 600),
+        seed: int = 0,
+    ) -> None:
+        if device not in DEVICES:
+            raise ConfigError(f"device={device!r}: choose one of {', '.join(DEVICES)}")
+        self.device, self.intent, self.dt = device, intent, dt
+        self.skill = skill if isinstance(skill, Skill) else Skill.of(skill)
+        self.keys = keyboard or KeyboardBindings()
+        self.mouse = mouse or MouseBindings()
+        self.joy = joystick or JoystickBindings()
+        self.window_size = window_size
+        grid = np.linspace(-1.0, 1.0, 401)
+        self._aims: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        for control in self.joy.axes:  # the axis position that gives each control value
+            shaped = np.array([self.joy.shape(control, x) for x in grid])
+            order = np.argsort(shaped, kind="stable")
+            self._aims[control] = (shaped[order], grid[order])
+        self._key_names = {
+            0: (self.keys.aileron_left[0], self.keys.aileron_right[0]),
+            1: (self.keys.elevator_up[0], self.keys.elevator_down[0]),  # nose up = -elevator
+            2: (self.keys.rudder_left[0], self.keys.rudder_right[0]),
+            3: (self.keys.throttle_down[0], self.keys.throttle_up[0]),
+        }
+        self.reset(seed)
+
+    # -- episode ---------------------------------------------------------------------------
+    def reset(self, seed: int | None = None) -> None:
+        self.rng = np.random.default_rng([0 if seed is None else seed, 104729])
+        self.intent.reset(seed)
+        delay = max(1, round(self.skill.reaction_s / self.dt))
+        self._seen: collections.deque[np.ndarray] = collections.deque(maxlen=delay)
+        self._held: dict[int, int] = {}  # control index -> direction (+1 / -1) of the key held
+        self._axes: dict[int, float] = {}  # joystick axis -> the value last sent
+        self._pointer: tuple[int, int] | None = None
+        self._lapse_left = 0.0
+        self._last_obs: np.ndarray | None = None
+        self._plugged = False
+        self.sent: list[Any] = []
+        self.pressed: list[tuple[str, bool]] = []  # (key, down) this frame, for the record
+
+    # -- deciding --------------------------------------------------------------------------
+    def _perceive(self, observation: np.ndarray) -> np.ndarray:
+        """What the pilot reads off the instruments, ``reaction_s`` late and imprecisely."""
+        obs = np.asarray(observation, dtype=np.float64)
+        if self.skill.perception and self._last_obs is not None:
+            change = np.abs(obs - self._last_obs) / self.dt  # how lively each reading is
+            obs = obs + self.rng.normal(0.0, 1.0, len(obs)) * self.skill.perception * change
+        self._last_obs = np.asarray(observation, dtype=np.float64)
+        self._seen.append(obs)
+        return self._seen[0]
+
+    def _lapsing(self) -> bool:
+        if self._lapse_left > 0:
+            self._lapse_left -= self.dt
+            return True
+        chance = self.skill.lapse_per_min * self.dt / 60.0
+        if self.rng.random() < chance:
+            self._lapse_left = self.skill.lapse_s
+            return True
+        return False
+
+    def events(self, observation: np.ndarray, stick: np.ndarray) -> list[Any]:
+        """This frame's events, from the observation and the controls as they stand (also
+        kept as ``sent``; the keys among them as ``pressed``: (name, down))."""
+        self.pressed = []
+        seen = self._perceive(observation)
+        want = np.clip(np.asarray(self.intent.act(seen), dtype=np.float64), ACTION_LOW, ACTION_HIGH)
+        out: list[Any] = []
+        if self.device == "joystick" and not self._plugged:
+            out.append(_event("JOYDEVICEADDED", device_index=0, instance_id=0))
+            self._plugged = True
+        if self._lapsing():
+            out += self._let_go()
+        elif self.device == "keyboard":
+            out += self._keyboard(want, stick, range(4))
+        elif self.device == "mouse":  # the pointer is the stick; rudder and throttle are keys
+            out += self._mouse(want) + self._keyboard(want, stick, (2, 3))
+        else:
+            out += self._joystick(want)
+        self.sent = out
+        return out
+
+    def _key(self, name: str, down: bool) -> Any:
+        self.pressed.append((name, down))
+        kind = "KEYDOWN" if down else "KEYUP"
+        return _event(kind, key=key_codes()[name], mod=0, unicode="", scancode=0)
+
+    def _let_go(self) -> list[Any]:
+        out = [self._key(self._key_names[i][(d + 1) // 2], False) for i, d in self._held.items()]
+        self._held.clear()
+        return out
+
+    def _keyboard(self, want: np.ndarray, stick: np.ndarray, controls: Any) -> list[Any]:
+        """Hold a key while the stick is off the mark; let go once it is past the mark."""
+        skill, out = self.skill, []
+        for i in controls:
+            error = float(want[i] - stick[i])
+            held = self._held.get(i)
+            if held is None:
+                if abs(error) > skill.deadband:
+                    direction = 1 if error > 0 else -1
+                    self._held[i] = direction
+                    out.append(self._key(self._key_names[i][(direction + 1) // 2], True))
+            elif held * error < -skill.overshoot:  # passed the mark by the overshoot
+                del self._held[i]
+                out.append(self._key(self._key_names[i][(held + 1) // 2], False))
+        return out
+
+    def _joystick(self, want: np.ndarray) -> list[Any]:
+        out = []
+        for control, axis in self.joy.axes.items():
+            i = CONTROLS.index(control)
+            raw = self._raw(control, float(want[i]) + self.rng.normal(0.0, self.skill.tremor))
+            raw = round(raw / self.skill.quantum) * self.skill.quantum
+            raw = max(-1.0, min(1.0, raw))
+            if self._axes.get(axis) != raw:
+                self._axes[axis] = raw
+                out.append(_event("JOYAXISMOTION", instance_id=0, axis=axis, value=raw))
+        return out
+
+    def _raw(self, control: str, wanted: float) -> float:
+        """The axis position whose shaped value is ``wanted`` (a person aims by eye; this
+        inverts the bindings' dead zone, expo and inversion)."""
+        shaped, raw = self._aims[control]
+        return float(np.interp(wanted, shaped, raw))
+
+    def _mouse(self, want: np.ndarray) -> list[Any]:
+        m = self.mouse
+        cx, cy = self.window_size[0] / 2, self.window_size[1] / 2
+        x = float(want[0]) + self.rng.normal(0.0, self.skill.tremor)
+        y = float(want[1]) + self.rng.normal(0.0, self.skill.tremor)
+        if m.invert_elevator:
+            y = -y
+        pos = (round(cx + x * m.span_px), round(cy - y * m.span_px))
+        if pos == self._pointer:
+            return []
+        self._pointer = pos
+        return [_event("MOUSEMOTION", pos=pos, rel=(0, 0), buttons=(0, 0, 0))]
+
+
+class PilotAgent:
+    """A synthetic pilot flying as an Agent: its events go straight to a ManualController,
+    whose controls are the action (what ``eval --pilot synthetic`` flies)."""
+
+    def __init__(self, pilot: SyntheticPilot, human: ManualController) -> None:
+        self.pilot, self.human = pilot, human
+
+    def reset(self, seed: int | None = None) -> None:
+        self.human.reset(seed)
+        self.pilot.reset(seed)
+
+    def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        events = self.pilot.events(observation, self.human.values)
+        self.human.handle(events, self.pilot.dt)
+        return self.human.act(observation)
