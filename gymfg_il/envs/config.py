@@ -4,12 +4,13 @@ the FlightGear views fed from the simulation."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from gymfg_il.envs.scenarios import Scenario
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
+from gymfg_il.sim.weather import Weather
 from gymfg_il.viz.multiplayer import port_problem
 
 
@@ -29,6 +30,7 @@ class EnvConfig:
         traffic: callsign -> multiplayer UDP ports of the views of that aircraft
             (``FlightGear(multiplayer_port=...)``): every other aircraft of the simulation,
             opponents of an online client included, is sent there and appears in the view.
+        weather: turbulence and wind (``sim.weather.Weather``), seeded per episode.
     """
 
     sim_hz: int = DEFAULT_SIM_HZ
@@ -37,6 +39,7 @@ class EnvConfig:
     scenario: Scenario | None = None
     views: Mapping[str, Sequence[int]] | None = None
     traffic: Mapping[str, Sequence[int]] | None = None
+    weather: Weather = field(default_factory=Weather)
 
     def __post_init__(self) -> None:
         substeps(self.sim_hz, self.agent_hz)

@@ -34,6 +34,7 @@ from gymfg_il.envs.team import Team
 from gymfg_il.errors import ConfigError, GymFGError, join_problems
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, episode_steps, substeps
+from gymfg_il.sim.weather import Turbulence, Weather
 from gymfg_il.tasks.library import task_class, task_reference
 
 if TYPE_CHECKING:
@@ -60,6 +61,10 @@ class FlightSpec:
         episode_time_s: episode length in seconds; reaching it truncates the episode.
         opponent_view: what an aircraft sees of other teams' aircraft.
         scenario: a joint start as a record (``envs.scenarios.scenario_record``), or None.
+        turbulence: none, light, moderate or severe (JSBSim's Dryden turbulence, seeded per
+            episode; ``sim.weather``).
+        wind_kt: a steady wind (knots).
+        wind_from_deg: where the wind blows from (true; None: drawn per episode).
     """
 
     teams: tuple[TeamSpec, ...] = field(default_factory=_default_teams)
@@ -68,6 +73,9 @@ class FlightSpec:
     episode_time_s: float = 90.0
     opponent_view: tuple[str, ...] = DEFAULT_OPPONENT_VIEW
     scenario: Mapping[str, Any] | None = None
+    turbulence: Turbulence = "none"
+    wind_kt: float = 0.0
+    wind_from_deg: float | None = None
 
     def __post_init__(self) -> None:
         problems: list[str] = []
@@ -76,6 +84,7 @@ class FlightSpec:
         if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
             problems.append(f"episode_time_s={t!r} must be a positive number of seconds")
         for check in (
+            lambda: self.weather,
             lambda: substeps(self.sim_hz, self.agent_hz),
             lambda: not problems and episode_steps(self.episode_time_s, self.agent_hz),
             lambda: indices(tuple(self.opponent_view)),
@@ -119,10 +128,17 @@ class FlightSpec:
         agent_hz: int = DEFAULT_AGENT_HZ,
         sim_hz: int = DEFAULT_SIM_HZ,
         episode_time_s: float = 90.0,
+        turbulence: Turbulence = "none",
+        wind_kt: float = 0.0,
+        wind_from_deg: float | None = None,
     ) -> FlightSpec:
         """One aircraft, callsign ``ego``, flying one task (what the gymnasium env flies)."""
         ego = AircraftSpec(aircraft, "ego", task, dynamic, dict(task_kwargs or {}))
-        return cls((TeamSpec("ego", (ego,)),), agent_hz, sim_hz, episode_time_s)
+        teams = (TeamSpec("ego", (ego,)),)
+        return cls(
+            teams, agent_hz, sim_hz, episode_time_s, DEFAULT_OPPONENT_VIEW, None, turbulence,
+            wind_kt, wind_from_deg,
+        )  # fmt: skip
 
     @property
     def is_solo(self) -> bool:
@@ -158,6 +174,10 @@ class FlightSpec:
     @property
     def task_label(self) -> str:
         return self.solo_aircraft.label
+
+    @property
+    def weather(self) -> Weather:
+        return Weather(self.turbulence, self.wind_kt, self.wind_from_deg)
 
     @property
     def aircraft_specs(self) -> list[AircraftSpec]:
@@ -197,6 +217,9 @@ class FlightSpec:
             "episode_time_s": self.episode_time_s,
             "opponent_view": list(self.opponent_view),
             "scenario": self.scenario,
+            "turbulence": self.turbulence,
+            "wind_kt": self.wind_kt,
+            "wind_from_deg": self.wind_from_deg,
         }
 
     def to_json(self) -> str:
@@ -269,6 +292,7 @@ class FlightSpec:
             }
             teams.append(TeamSpec(team.name, tuple(roster), targets))
         config = world.config
+        weather = config.weather
         return cls(
             tuple(teams),
             config.agent_hz,
@@ -276,6 +300,9 @@ class FlightSpec:
             world.max_steps / config.agent_hz,
             config.opponent_view,
             scenario_record(config.scenario),
+            weather.turbulence,
+            weather.wind_kt,
+            weather.wind_from_deg,
         )
 
     def rebuild_problems(self) -> list[str]:
@@ -333,6 +360,7 @@ class FlightSpec:
             scenario if scenario is not None else scenario_from_record(self.scenario),
             views,
             traffic,
+            self.weather,
         )
 
     def make_world(

@@ -28,6 +28,7 @@ from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
+from gymfg_il.sim.weather import Weather
 
 TeamState = list[np.ndarray]
 
@@ -39,7 +40,7 @@ class OfflineEnv:
     Args:
         opponents: ``[(team, [agent per aircraft in roster order]), ...]``: teams flown by the
             environment itself.
-        sim_hz, agent_hz, opponent_view, scenario, views, traffic: see ``EnvConfig``
+        sim_hz, agent_hz, opponent_view, scenario, views, traffic, weather: see ``EnvConfig``
             (views: callsign -> FlightGear UDP ports; traffic: callsign -> the multiplayer
             ports of its views, where the other aircraft are shown).
 
@@ -66,8 +67,11 @@ class OfflineEnv:
         scenario: Scenario | None = None,
         views: Mapping[str, Sequence[int]] | None = None,
         traffic: Mapping[str, Sequence[int]] | None = None,
+        weather: Weather | None = None,
     ) -> None:
-        self.config = EnvConfig(sim_hz, agent_hz, tuple(opponent_view), scenario, views, traffic)
+        self.config = EnvConfig(
+            sim_hz, agent_hz, tuple(opponent_view), scenario, views, traffic, weather or Weather()
+        )
         self.opponents: list[tuple[Team, list[Agent]]] = []
         for entry in opponents:
             if not (isinstance(entry, tuple) and len(entry) == 2 and isinstance(entry[0], Team)):

@@ -19,6 +19,7 @@ from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
+from gymfg_il.sim.weather import Turbulence, Weather
 from gymfg_il.tasks.base import Task
 from gymfg_il.tasks.targets import TargetTask
 
@@ -38,6 +39,8 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         episode_time_s: episode length; reaching it sets ``truncated``.
         views: UDP ports of FlightGear views of the aircraft (``viz.flightgear``); with a view
             attached the env runs at real time.
+        turbulence, wind_kt, wind_from_deg: the weather (``sim.weather``): JSBSim's
+            turbulence (none, light, moderate, severe) and a steady wind, seeded per episode.
 
     Observation: the task's observation (float32, names in ``env.observation_names``; see the
     task's docstring for the table with units). Action: ``Box([-1, -1, -1, 0], [1, 1, 1, 1])`` =
@@ -68,6 +71,9 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         episode_time_s: float = 90.0,
         render_mode: str | None = None,
         views: Sequence[int] | None = None,
+        turbulence: Turbulence = "none",
+        wind_kt: float = 0.0,
+        wind_from_deg: float | None = None,
     ) -> None:
         if render_mode is not None:
             raise ConfigError(f"render_mode={render_mode!r} is not supported; use None")
@@ -82,6 +88,9 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
                 agent_hz=agent_hz,
                 sim_hz=sim_hz,
                 episode_time_s=episode_time_s,
+                turbulence=turbulence,
+                wind_kt=wind_kt,
+                wind_from_deg=wind_from_deg,
             )
             team = flight.build_teams()[0]
         else:
@@ -98,7 +107,10 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         self.world = World(
             [team],
             EnvConfig(
-                sim_hz=sim_hz, agent_hz=agent_hz, views={"ego": list(views)} if views else None
+                sim_hz=sim_hz,
+                agent_hz=agent_hz,
+                views={"ego": list(views)} if views else None,
+                weather=Weather(turbulence, wind_kt, wind_from_deg),
             ),
         )
         self.flight = flight or FlightSpec.of_world(self.world)
@@ -124,6 +136,9 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
             sim_hz=flight.sim_hz,
             episode_time_s=flight.episode_time_s,
             views=views,
+            turbulence=flight.turbulence,
+            wind_kt=flight.wind_kt,
+            wind_from_deg=flight.wind_from_deg,
         )
 
     @property

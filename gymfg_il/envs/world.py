@@ -210,11 +210,15 @@ class World:
         if unknown:
             raise ConfigError(f"initial conditions given for unknown callsigns {sorted(unknown)}")
         self.others.clear()  # last episode's opponents are not shown at this one's start
+        weather = self.config.weather
         for slot in self.slots:
-            own = np.random.default_rng([base, 1 + zlib.crc32(slot.callsign.encode())])
+            key = zlib.crc32(slot.callsign.encode())
+            # the air gets a stream of its own: calm episodes draw exactly what they always did
+            air = weather.draw(np.random.default_rng([base, 2, key]))
+            own = np.random.default_rng([base, 1 + key])
             ic = ics.get(slot.callsign) or slot.task.initial_conditions(own)
             throttle = slot.aircraft.profile.cruise_throttle
-            slot.state = slot.prev_state = slot.sim.reset(ic, throttle)
+            slot.state = slot.prev_state = slot.sim.reset(ic, throttle, air)
             slot.task.reset(slot.state, own)
             slot.action = slot.prev_action = np.array([0.0, 0.0, 0.0, throttle])
             slot.reward = 0.0

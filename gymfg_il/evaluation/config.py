@@ -7,7 +7,7 @@ import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, join_problems
@@ -44,6 +44,14 @@ class EvalConfig:
         json: write the rows as JSON to this file.
         plots: write Figure-1 plots (one PNG per agent) to this folder.
         plot_episodes: episodes (rows) per plot.
+        turbulence: fly in JSBSim's turbulence: none, light, moderate or severe (seeded per
+            episode; default: the policy's flight's, else none).
+        wind_kt: a steady wind from a direction drawn per episode (default: the policy's
+            flight's, else none).
+        pilot: also fly the synthetic pilot (a model of a person at the controls) on the
+            same seeds: its row is pilot:synthetic-DEVICE.
+        device: the synthetic pilot's device: keyboard, joystick or mouse.
+        skill: the synthetic pilot's level, 0 (a novice) to 1 (an ace).
     """
 
     policy: list[Path] = field(default_factory=list, metadata={"repeat": True})
@@ -58,12 +66,19 @@ class EvalConfig:
     json: Path | None = None
     plots: Path | None = None
     plot_episodes: int = 4
+    turbulence: Literal["none", "light", "moderate", "severe"] | None = None
+    wind_kt: float | None = None
+    pilot: Literal["synthetic"] | None = None
+    device: Literal["keyboard", "joystick", "mouse"] = "keyboard"
+    skill: float = 0.7
 
     def __post_init__(self) -> None:
         self.policy = [Path(p) for p in self.policy]
         problems = []
         if self.task is not None and self.task not in TASKS:
             problems.append(f"task={self.task!r}: choose one of {', '.join(TASKS)}")
+        if not 0.0 <= self.skill <= 1.0:
+            problems.append(f"skill={self.skill}: want 0 (a novice) .. 1 (an ace)")
         for name in ("episodes", "workers", "plot_episodes"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
@@ -100,6 +115,8 @@ def plan(cfg: EvalConfig) -> tuple[FlightSpec, dict[str, AgentSpec], list[str]]:
         aircraft=cfg.aircraft,
         agent_hz=cfg.agent_hz,
         episode_time_s=cfg.episode_time_s,
+        turbulence=cfg.turbulence,
+        wind_kt=cfg.wind_kt,
     )
     env = flight.make_env()
     try:
@@ -108,6 +125,8 @@ def plan(cfg: EvalConfig) -> tuple[FlightSpec, dict[str, AgentSpec], list[str]]:
     finally:
         env.close()
     agents = {"controller": AgentSpec.controller()}
+    if cfg.pilot == "synthetic":
+        agents[f"pilot:synthetic-{cfg.device}"] = AgentSpec.synthetic(cfg.device, cfg.skill)
     names = [p.name for p in cfg.policy]
     for path in cfg.policy:  # a folder name twice (run1/policy, run2/policy): the whole path
         agents[f"policy:{path.name if names.count(path.name) == 1 else path}"] = AgentSpec.policy(

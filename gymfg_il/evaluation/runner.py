@@ -26,6 +26,8 @@ _FLAGS = {
     "dynamic": "dynamic",
     "aircraft": "aircraft",
     "episode_time_s": "episode_time_s",
+    "turbulence": "turbulence",
+    "wind_kt": "wind_kt",
 }
 
 
@@ -37,6 +39,8 @@ def flight_for(
     aircraft: str | None = None,
     agent_hz: int | None = None,
     episode_time_s: float | None = None,
+    turbulence: str | None = None,
+    wind_kt: float | None = None,
 ) -> tuple[FlightSpec, list[str]]:
     """What to fly: the policies' own flight, changed where a flag asks (each change is
     returned as a note to print), or, without policies, the flags over the defaults.
@@ -52,7 +56,7 @@ def flight_for(
             "flies the same cases: evaluate them separately"
         )
     asked: dict[str, Any] = {"task": task, "dynamic": dynamic, "aircraft": aircraft}
-    asked["episode_time_s"] = episode_time_s
+    asked.update(episode_time_s=episode_time_s, turbulence=turbulence, wind_kt=wind_kt)
     notes: list[str] = []
     if not known:
         missing = ", ".join(str(p) for p in policies)
@@ -118,7 +122,8 @@ def evaluate(
     for name, agent in agents.items():
         tick = (lambda _episode, name=name: progress(name)) if progress else None
         episodes = fly_many(flight, agent, seeds, workers, progress=tick)
-        traces[name] = [trace_of(e) for e in episodes]
+        gusty = flight.turbulence != "none"
+        traces[name] = [trace_of(e, gusty=gusty) for e in episodes]
         row = summarize(name, flight.task_label, flight.aircraft, traces[name])
         row.update(
             agent_hz=flight.agent_hz,

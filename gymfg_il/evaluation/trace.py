@@ -35,6 +35,7 @@ class Trace:
     rewards: np.ndarray
     terminated: bool
     reason: str | None
+    gusty: bool = False  # flown in turbulence: success is judged on the mean error
 
     @property
     def time_s(self) -> np.ndarray:
@@ -45,8 +46,9 @@ class Trace:
         return float(self.rewards.sum())
 
 
-def trace_of(episode: Episode, callsign: str | None = None) -> Trace:
-    """The trace of one aircraft of ``episode`` (the only one, unless ``callsign``)."""
+def trace_of(episode: Episode, callsign: str | None = None, gusty: bool = False) -> Trace:
+    """The trace of one aircraft of ``episode`` (the only one, unless ``callsign``);
+    ``gusty``: it was flown in turbulence."""
     t = episode.solo if callsign is None else episode.trajectories[callsign]
     task = t.start.task
     tracked = task.get("tracked")
@@ -69,4 +71,5 @@ def trace_of(episode: Episode, callsign: str | None = None) -> Trace:
         rewards=t.rewards,
         terminated=t.terminated,
         reason=t.reason,
+        gusty=gusty,
     )

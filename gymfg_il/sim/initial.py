@@ -77,12 +77,16 @@ class InitialConditions:
         if problems:
             raise ConfigError("InitialConditions: " + "; ".join(problems))
 
-    def to_xml(self) -> str:
-        """A JSBSim v2 initialization file holding exactly this state."""
+    def to_xml(self, wind_fps: tuple[float, float] = (0.0, 0.0)) -> str:
+        """A JSBSim v2 initialization file holding exactly this state; with a wind (north,
+        east, ft/s) the ground velocity is the air velocity plus the wind, so the airspeed
+        is the one asked for."""
         x, y, z = ecef_ft(self.latitude_deg, self.longitude_deg, self.altitude_ft)
         speed = self.airspeed_kts * _KTS_TO_FPS
         psi = math.radians(self.heading_deg)
         north, east = speed * math.cos(psi), speed * math.sin(psi)
+        if wind_fps != (0.0, 0.0):
+            north, east = north + wind_fps[0], east + wind_fps[1]
         return (
             '<?xml version="1.0"?>\n<initialize name="gymfg" version="2.0">\n'
             f' <elevation unit="FT">{self.terrain_elevation_ft!r}</elevation>\n'

@@ -19,6 +19,9 @@ from gymfg_il.aircraft import jsbsim_root, resolve_model
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import CATALOGUE, StateVar
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
+from gymfg_il.sim.weather import Air
+
+CALM = Air()
 
 log = logging.getLogger(__name__)
 
@@ -96,9 +99,13 @@ class Simulation:
         """Seconds of simulated time per agent step."""
         return self.substeps / self.sim_hz
 
-    def reset(self, ic: InitialConditions, throttle: float = 0.0) -> np.ndarray:
-        """Put the aircraft in ``ic`` with engines running; return the first state vector."""
-        xml = ic.to_xml().replace("</initialize>", " <running>-1</running>\n</initialize>")
+    def reset(
+        self, ic: InitialConditions, throttle: float = 0.0, air: Air | None = None
+    ) -> np.ndarray:
+        """Put the aircraft in ``ic`` with engines running, in ``air`` (calm by default);
+        return the first state vector."""
+        air = air or CALM
+        xml = ic.to_xml(air.wind).replace("</initialize>", " <running>-1</running>\n</initialize>")
         fdm = self.fdm
         # JSBSim reads initial conditions only from a file. It lives just for the load, so
         # worker processes that exit without atexit, or a kill -9, leave nothing behind.
@@ -109,6 +116,7 @@ class Simulation:
             fdm.get_ic().load(path, False)
         finally:
             os.remove(path)
+        air.before_reset(fdm)
         for prop in self._mixtures:
             fdm[prop] = 1.0
         self.apply(0.0, 0.0, 0.0, throttle, run=False)
