@@ -1,6 +1,7 @@
 """The synthetic pilot flies through the real session loop: what it pressed is what the
 dataset shows, and it flies like a person (late, in taps, sometimes not at all)."""
 
+import json
 import os
 
 import numpy as np
@@ -66,3 +67,19 @@ def test_collect_manual_with_the_synthetic_pilot_runs_headless(tmp_path, capsys)
     frames = load_frames(tmp_path / "dataset")
     assert frames.episodes["gymfg/source"] == ["synthetic"] * 2 and len(frames) == 300
     assert frames.episodes["gymfg/seed"] == [0, 1]
+
+
+def test_eval_scores_the_synthetic_pilot_beside_the_controller(tmp_path):
+    from gymfg_il import eval as evaluate
+
+    argv = ["--pilot", "synthetic", "--device", "keyboard", "--task", "altitude",
+            "--episodes", "2", "--episode-time", "40", "--no-progress",
+            "--json", str(tmp_path / "rows.json")]  # fmt: skip
+    assert evaluate.main(argv) == 0
+    rows = json.loads((tmp_path / "rows.json").read_text())["rows"]
+    controller, pilot = rows
+    assert controller["agent"] == "controller" and "synthetic" in pilot["agent"]
+    assert pilot["seeds"] == controller["seeds"] == [0, 1]
+    assert pilot["terminated"] == 0
+    # a person in taps is good, not a PID: it loses some return to the controller
+    assert 0.5 < pilot["return_ratio"] < 1.0
