@@ -52,6 +52,8 @@ def _bc(cfg: object, show_progress: bool) -> int:
         f"-> {result.train_loss[-1]:.4f}, validation {result.val_loss[-1]:.4f}"
     )
     print(f"policy saved to {result.out} (loss curve: {result.out / 'loss.png'})")
+    if result.overfit:
+        print(f"warning: {result.overfit}", file=sys.stderr)
     return 0
 
 

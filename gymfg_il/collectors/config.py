@@ -32,8 +32,11 @@ class CollectConfig:
         episode_time_s: seconds per episode.
         agent_hz: agent rate = the dataset's fps, a divisor of 120.
         seed: seed of the first episode (episode i uses seed + i).
-        noise: DART-style noise: std of Gaussian noise added to the executed surfaces (the
-            dataset keeps the demonstrator's clean action as the label); 0 = none.
+        noise: autopilot only: DART-style noise: std of Gaussian noise added to the executed
+            surfaces (the dataset keeps the demonstrator's clean action as the label), so the
+            demonstrations show how to recover from small deviations; 0 = none. Without it,
+            behaviour cloning from a PID's demonstrations fails (0% of held-out c172p roll
+            episodes with 40 demonstrations against 100% at 0.02).
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
         task_kwargs: arguments of the task class (e.g. ``target_range``).
         device: manual only: keyboard, mouse or joystick.
@@ -58,7 +61,7 @@ class CollectConfig:
     episode_time_s: float = field(default=90.0, metadata={"flag": "--episode-time"})
     agent_hz: int = DEFAULT_AGENT_HZ
     seed: int = 0
-    noise: float = 0.0
+    noise: float = 0.02
     out: Path = Path("datasets/autopilot")
     task_kwargs: dict[str, Any] = field(default_factory=dict)
     device: Literal["keyboard", "mouse", "joystick"] = "keyboard"
