@@ -34,6 +34,7 @@ class Frames:
     obs_stats: dict[str, np.ndarray]
     action_stats: dict[str, np.ndarray]
     episodes: dict[str, list[Any]] = field(default_factory=dict)  # per-episode metadata
+    intervention: np.ndarray | None = None  # (N,) bool: a person took over from a policy
 
     def __len__(self) -> int:
         return len(self.action)
@@ -59,8 +60,23 @@ class Frames:
             )
         return alike.pop(), ""
 
+    def demonstrated(self) -> Frames:
+        """The frames a demonstrator flew: every frame of a demonstration, and of an episode a
+        policy flew with a person (or the synthetic pilot) watching (source ``policy+...``),
+        only the frames they took over (human-gated DAgger learns from the takeovers alone;
+        the policy's own frames would teach it what it already does)."""
+        sources = self.episodes.get("gymfg/source")
+        if self.intervention is None or not sources:
+            return self
+        ids = self.episodes.get("episode_index", list(range(len(sources))))
+        assisted = [i for i, src in zip(ids, sources, strict=True) if src.startswith("policy+")]
+        keep = ~np.isin(self.episode, assisted) | self.intervention
+        return self if keep.all() else self._take(keep)
+
     def select(self, episodes: np.ndarray) -> Frames:
-        keep = np.isin(self.episode, episodes)
+        return self._take(np.isin(self.episode, episodes))
+
+    def _take(self, keep: np.ndarray) -> Frames:
         return Frames(
             self.obs[keep],
             self.action[keep],
@@ -72,6 +88,7 @@ class Frames:
             self.obs_stats,
             self.action_stats,
             self.episodes,
+            None if self.intervention is None else self.intervention[keep],
         )
 
 
@@ -127,6 +144,11 @@ def load_frames(root: Path) -> Frames:
         obs_stats={k: np.asarray(stats["observation.state"][k]) for k in ("mean", "std")},
         action_stats={k: np.asarray(stats["action"][k]) for k in ("mean", "std")},
         episodes=episodes,
+        intervention=(
+            _column(table, "intervention").astype(bool).reshape(-1)
+            if "intervention" in features
+            else None
+        ),
     )
 
 
@@ -173,6 +195,7 @@ class TensorBatches:
             ends = np.arange(len(frames)) + sequence - 1
             ok = ends < len(frames)
             ok[ok] &= frames.episode[ends[ok]] == frames.episode[ok]
+            ok[ok] &= frames.frame[ends[ok]] - frames.frame[ok] == sequence - 1  # no gaps
             starts = np.flatnonzero(ok)
             if len(starts) == 0:
                 raise ConfigError(f"no episode is {sequence} steps long; lower sequence_length")

@@ -30,7 +30,7 @@ class GRUPolicy(NormalizedPolicy):
         self, obs: torch.Tensor, state: torch.Tensor | None = None
     ) -> tuple[torch.Tensor, torch.Tensor]:
         """(normalised actions, state) for raw observations of shape (batch, time, n_obs)."""
-        out, state = self.gru(self.encoder(self.obs_norm(obs)), state)
+        out, state = self.gru(self.encoder(self.normalized(obs)), state)
         return self.head(out), state
 
     def loss(self, obs: torch.Tensor, action: torch.Tensor) -> torch.Tensor:

@@ -34,7 +34,7 @@ class MLPPolicy(NormalizedPolicy):
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         """Normalised action predicted from raw observations (any leading dims)."""
-        return self.net(self.obs_norm(obs))
+        return self.net(self.normalized(obs))
 
     def loss(self, obs: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
         return nn.functional.mse_loss(self.forward(obs), self.action_norm(action))

@@ -38,3 +38,12 @@ class NormalizedPolicy(nn.Module):
         self.obs_norm = Normalizer(obs_stats["mean"], obs_stats["std"])
         self.action_norm = Normalizer(action_stats["mean"], action_stats["std"])
         self.n_obs, self.n_act = len(obs_stats["mean"]), len(action_stats["mean"])
+        self.obs_noise = 0.0  # training only: std of noise on the normalised observation
+
+    def normalized(self, obs: torch.Tensor) -> torch.Tensor:
+        """The normalised observation; while training, with ``obs_noise`` added (the policy
+        learns to act alike in a neighbourhood of each demonstrated state)."""
+        x = self.obs_norm(obs)
+        if self.training and self.obs_noise:
+            x = x + self.obs_noise * torch.randn_like(x)
+        return x

@@ -88,6 +88,27 @@ def test_batches_and_split(tiny_dataset):
     assert (ep[starts] == ep[starts + 15]).all()  # no window crosses an episode boundary
 
 
+def test_human_gated_episodes_teach_only_their_takeovers(tiny_dataset):
+    frames = load_frames(tiny_dataset)
+    assert frames.intervention is not None and not frames.intervention.any()
+    assert frames.demonstrated() is frames  # demonstrations are kept whole
+    # episode 1 becomes a policy flight a person watched, taking over for 20 frames
+    sources = list(frames.episodes["gymfg/source"])
+    sources[1] = "policy+synthetic"
+    frames.episodes = {**frames.episodes, "gymfg/source": sources}
+    frames.intervention = frames.intervention.copy()
+    took = np.flatnonzero(frames.episode == 1)[100:120]
+    frames.intervention[took] = True
+    kept = frames.demonstrated()
+    assert len(kept) == len(frames) - (frames.episode == 1).sum() + 20
+    assert (kept.frame[kept.episode == 1] == frames.frame[took]).all()
+    # a GRU window never spans the gaps the policy's own frames leave
+    windows = TensorBatches(kept, 8, sequence=10, seed=0)
+    starts = windows.starts.numpy()
+    assert (kept.frame[starts + 9] - kept.frame[starts] == 9).all()
+    assert (kept.episode[starts] == 1).sum() == 20 - 9
+
+
 def test_bad_training_inputs(tmp_path):
     with pytest.raises(ConfigError, match="no LeRobot dataset"):
         train_bc(TrainConfig(dataset=tmp_path / "missing", epochs=1))
