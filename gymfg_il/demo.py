@@ -19,6 +19,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from gymfg_il.learning.bc import DEFAULT_DATASET, TrainConfig
+
 RECIPE = Path("collectors/sample.toml")
 
 
@@ -28,15 +30,15 @@ class DemoConfig:
 
     Attributes:
         dataset: demonstrations to learn from (the bundled sample by default).
-        epochs: training epochs.
+        epochs: training epochs (train bc's default).
         episodes: held-out evaluation episodes.
         workers: evaluation worker processes.
         runs: where the report folder goes.
         progress: progress bars.
     """
 
-    dataset: Path = Path("datasets/sample-altitude-c172p/dataset")
-    epochs: int = 30
+    dataset: Path = DEFAULT_DATASET
+    epochs: int = TrainConfig.epochs
     episodes: int = 10
     workers: int = 2
     runs: Path = Path("runs")
