@@ -89,6 +89,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         defaults={"agent_hz": 30, "episodes": 0, "out": Path("datasets/manual")},
         flags={"agent_hz": "--fps"},
     )
+    manual.add_argument(
+        "--no-progress", action="store_true", help="no progress bar (--pilot synthetic)"
+    )
     dagger = sub.add_parser(
         "dagger",
         help="the policy flies, the controller labels what it visits, the data is aggregated "
@@ -128,7 +131,7 @@ def _autopilot(args: argparse.Namespace) -> int:
         if cfg.kind == "manual":
             if "noise" in options or args.workers != 1:
                 raise ConfigError("--noise and --workers apply to autopilot recipes, not manual")
-            return _fly_by_hand(cfg)
+            return _fly_by_hand(cfg, not args.no_progress)
         manual_only = sorted(set(options) & (set(MANUAL) - set(AUTOPILOT)))
         if manual_only:
             flags = ", ".join("--" + k.replace("_", "-") for k in manual_only)
@@ -165,12 +168,13 @@ def _manual(args: argparse.Namespace) -> int:
     from gymfg_il import cli
     from gymfg_il.collectors.config import CollectConfig
 
-    return _fly_by_hand(cli.build(CollectConfig, args, kind="manual"))
+    return _fly_by_hand(cli.build(CollectConfig, args, kind="manual"), not args.no_progress)
 
 
-def _fly_by_hand(cfg: object) -> int:
+def _fly_by_hand(cfg: object, show_progress: bool = True) -> int:
     import os
 
+    from gymfg_il import cli
     from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.collectors.manual import ManualSession
 
@@ -180,8 +184,15 @@ def _fly_by_hand(cfg: object) -> int:
         from gymfg_il.collectors.synthetic import SyntheticDriver
 
         os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+        driver = SyntheticDriver(cfg.skill)
+        bar = cli.progress_bar(cfg.episodes, "episodes", "ep", show_progress)
+
+        def fly(frame: int, session: ManualSession) -> None:
+            driver(frame, session)
+            bar.update(session.stats.saved - bar.n)
+
         synthetic = {
-            "on_frame": SyntheticDriver(cfg.skill),
+            "on_frame": fly,
             "realtime": False,
             "source": "synthetic",
             "draw": False,
@@ -199,6 +210,9 @@ def _fly_by_hand(cfg: object) -> int:
         **synthetic,  # type: ignore[arg-type]
     )
     stats = session.run()
+    if synthetic:
+        bar.update(stats.saved - bar.n)
+        bar.close()
     print(
         f"saved {stats.saved} episode(s), discarded {stats.discarded}; dataset: "
         f"{stats.dataset or 'none yet'}"

@@ -63,7 +63,8 @@ def test_collect_manual_with_the_synthetic_pilot_runs_headless(tmp_path, capsys)
     argv = ["manual", "--pilot", "synthetic", "--device", "keyboard", "--task", "roll",
             "--episodes", "2", "--episode-time", "5", "--out", str(tmp_path)]  # fmt: skip
     assert collect.main(argv) == 0
-    assert "saved 2 episode(s)" in capsys.readouterr().out
+    out, err = capsys.readouterr()
+    assert "saved 2 episode(s)" in out and "2/2" in err  # the progress bar reached the end
     frames = load_frames(tmp_path / "dataset")
     assert frames.episodes["gymfg/source"] == ["synthetic"] * 2 and len(frames) == 300
     assert frames.episodes["gymfg/seed"] == [0, 1]
