@@ -19,7 +19,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 EPILOG = __doc__.split("\n\n", 1)[1]
-FLIGHT = ("aircraft", "task", "dynamic", "episode_time_s", "seed")
+FLIGHT = ("aircraft", "task", "dynamic", "episode_time_s", "seed", "turbulence", "wind_kt")
 AUTOPILOT = (*FLIGHT, "episodes", "agent_hz", "noise", "out")
 MANUAL = (*FLIGHT, "device", "agent_hz", "episodes", "assist", "out", "view", "pilot", "skill")
 RECIPE = tuple(dict.fromkeys(AUTOPILOT + MANUAL))

@@ -37,6 +37,10 @@ class CollectConfig:
             demonstrations show how to recover from small deviations; 0 = none. Without it,
             behaviour cloning from a PID's demonstrations fails (0% of held-out c172p roll
             episodes with 40 demonstrations against 100% at 0.02).
+        turbulence: fly in JSBSim's turbulence: none, light, moderate or severe (seeded per
+            episode, recorded in the flight spec, so a policy is evaluated in it by default).
+            A policy cloned from still-air demonstrations drifts off its target in turbulence.
+        wind_kt: a steady wind from a direction drawn per episode.
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
         task_kwargs: arguments of the task class (e.g. ``target_range``).
         device: manual only: keyboard, mouse or joystick.
@@ -62,6 +66,8 @@ class CollectConfig:
     agent_hz: int = DEFAULT_AGENT_HZ
     seed: int = 0
     noise: float = 0.02
+    turbulence: Literal["none", "light", "moderate", "severe"] = "none"
+    wind_kt: float = 0.0
     out: Path = Path("datasets/autopilot")
     task_kwargs: dict[str, Any] = field(default_factory=dict)
     device: Literal["keyboard", "mouse", "joystick"] = "keyboard"
@@ -115,6 +121,8 @@ class CollectConfig:
             task_kwargs=self.task_kwargs,
             agent_hz=self.agent_hz,
             episode_time_s=self.episode_time_s,
+            turbulence=self.turbulence,
+            wind_kt=self.wind_kt,
         )
 
     @classmethod

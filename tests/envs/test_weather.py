@@ -69,3 +69,15 @@ def test_controllers_hold_their_targets_in_moderate_turbulence():
         (row,) = run.rows
         assert row["success_rate"] >= 0.75 and row["terminated"] == 0
         assert row["spec"]["turbulence"] == "moderate"
+
+
+def test_demonstrations_can_be_collected_in_turbulence_and_keep_it_in_their_spec(tmp_path):
+    from gymfg_il import collect
+    from gymfg_il.learning.data import load_frames
+
+    argv = ["autopilot", "--task", "roll", "--episodes", "1", "--episode-time", "3",
+            "--turbulence", "light", "--wind-kt", "5", "--out", str(tmp_path), "--no-progress"]  # fmt: skip
+    assert collect.main(argv) == 0
+    flight, why = load_frames(tmp_path / "dataset").flight()
+    assert flight is not None, why
+    assert flight.weather.turbulence == "light" and flight.weather.wind_kt == 5.0
