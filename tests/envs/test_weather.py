@@ -76,7 +76,8 @@ def test_demonstrations_can_be_collected_in_turbulence_and_keep_it_in_their_spec
     from gymfg_il.learning.data import load_frames
 
     argv = ["autopilot", "--task", "roll", "--episodes", "1", "--episode-time", "3",
-            "--turbulence", "light", "--wind-kt", "5", "--out", str(tmp_path), "--no-progress"]  # fmt: skip
+            "--turbulence", "light", "--wind-kt", "5", "--out", str(tmp_path),
+            "--no-progress"]  # fmt: skip
     assert collect.main(argv) == 0
     flight, why = load_frames(tmp_path / "dataset").flight()
     assert flight is not None, why
