@@ -211,6 +211,7 @@ class ManualSession:
         return self.writer
 
     def _start(self) -> None:
+        self.updater.warm()  # its imports overlap the flying
         seed = self.next_seed
         starts = self.rollout.reset(seed)
         self.step_count, self.interventions = 0, 0

@@ -1,6 +1,7 @@
 """The manual collector driven headless by injected pygame events, for all three devices."""
 
 import os
+import shutil
 
 import numpy as np
 import pytest
@@ -173,3 +174,28 @@ def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
     (policy / "config.json").write_text(json.dumps({**config, "spec": spec.to_dict(), "fps": 10}))
     with pytest.raises(ConfigError, match=r"trained at 10 Hz.*at 30 Hz"):
         ManualSession(SPEC, tmp_path / "out", assist=str(policy), realtime=False)
+
+
+def test_the_dataset_helper_builds_on_request_and_outlives_a_crash(tmp_path, caplog):
+    from gymfg_il import collect
+    from gymfg_il.collectors.updater import DatasetUpdater
+
+    argv = ["autopilot", "--episodes", "2", "--episode-time", "2", "--out", str(tmp_path),
+            "--no-progress"]  # fmt: skip
+    assert collect.main(argv) == 0
+    shutil.rmtree(tmp_path / "dataset")
+    updater = DatasetUpdater(tmp_path)
+    updater.warm()
+    assert updater.proc is not None
+    updater.proc.kill()  # the helper dies before its first build: another takes over
+    updater.proc.wait()
+    updater.request()
+    updater.request()  # while one builds: one more after it
+    assert updater.pending and updater.close() and updater.failures == 0
+    assert len(load_frames(tmp_path / "dataset").episodes["gymfg/seed"]) == 2
+    (tmp_path / "logs" / "zz-broken.mcap").write_bytes(os.urandom(4000))
+    updater = DatasetUpdater(tmp_path)
+    updater.request()
+    assert not updater.close() and updater.failures == 1  # the session hears why
+    assert "not a readable GymFG trajectory log" in caplog.text and "collect recover" in caplog.text
+    assert len(load_frames(tmp_path / "dataset").episodes["gymfg/seed"]) == 2  # nothing lost
