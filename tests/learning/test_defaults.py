@@ -14,11 +14,13 @@ from gymfg_il.evaluation.config import EvalConfig, run_eval
 from gymfg_il.learning.bc import TrainConfig, TrainResult, train_bc
 
 
-@pytest.mark.parametrize("task", ["roll", "altitude"])
+# altitude needs the 40 demonstrations: from 20, its policy holds the 50-ft tolerance
+# in 14 of 16 held-out episodes (a steady offset, no crash)
+@pytest.mark.parametrize(("task", "demonstrations"), [("roll", 20), ("altitude", 40)])
 def test_clean_demonstrations_with_default_settings_give_a_policy_that_does_not_crash(
-    task, tmp_path
+    task, demonstrations, tmp_path
 ):
-    cfg = CollectConfig(task=task, episodes=20, seed=1000, out=tmp_path / "demos")
+    cfg = CollectConfig(task=task, episodes=demonstrations, seed=1000, out=tmp_path / "demos")
     assert cfg.noise > 0  # the default that makes the rest hold
     collect_autopilot(cfg, workers=2)
     result = train_bc(TrainConfig(dataset=tmp_path / "demos" / "dataset", out=tmp_path / "p"))
