@@ -209,10 +209,12 @@ def _fly_by_hand(cfg: object, show_progress: bool = True) -> int:
         views=tuple(cfg.view),
         **synthetic,  # type: ignore[arg-type]
     )
-    stats = session.run()
-    if synthetic:
-        bar.update(stats.saved - bar.n)
-        bar.close()
+    try:
+        stats = session.run()
+    finally:
+        if synthetic:
+            bar.update(session.stats.saved - bar.n)
+            bar.close()
     print(
         f"saved {stats.saved} episode(s), discarded {stats.discarded}; dataset: "
         f"{stats.dataset or 'none yet'}"

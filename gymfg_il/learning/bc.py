@@ -133,12 +133,26 @@ def train_bc(
     """Train, save the checkpoint and a loss-curve plot under ``cfg.out``."""
     import torch
 
+    threads = torch.get_num_threads()
+    if resolve_device(cfg.device) == "cpu" and cfg.threads > 0:
+        torch.set_num_threads(cfg.threads)
+    try:
+        return _train(cfg, on_epoch, frames)
+    finally:
+        torch.set_num_threads(threads)  # the caller's setting, as it was
+
+
+def _train(
+    cfg: TrainConfig,
+    on_epoch: Callable[[int, float, float], None] | None,
+    frames: Any,
+) -> TrainResult:
+    import torch
+
     from gymfg_il.learning.data import TensorBatches, load_frames, split_by_episode
     from gymfg_il.policies.factory import make_config, make_policy, save_policy
 
     device = resolve_device(cfg.device)
-    if device == "cpu" and cfg.threads > 0:
-        torch.set_num_threads(cfg.threads)
     frames = frames if frames is not None else load_frames(cfg.dataset)
     shown = frames.demonstrated()  # of a policy's own flying, only a person's takeovers
     if len(shown) < len(frames):
