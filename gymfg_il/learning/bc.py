@@ -187,7 +187,12 @@ def _train(
     policy = make_policy(pconf, frames.obs_stats, frames.action_stats).to(device)
     policy.obs_noise = cfg.obs_noise
     batches = TensorBatches(train, cfg.batch_size, device, sequence, cfg.seed)
-    val_batches = TensorBatches(val, 4096, device, sequence, cfg.seed) if val else None
+    val_batches = None
+    if val:
+        try:
+            val_batches = TensorBatches(val, 4096, device, sequence, cfg.seed)
+        except ConfigError as err:  # held-out frames too short for a window: train on
+            log.warning("no validation loss: the held-out episodes are too short (%s)", err)
     opt = torch.optim.AdamW(policy.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     steps = cfg.epochs * len(batches)
     sched = torch.optim.lr_scheduler.LambdaLR(

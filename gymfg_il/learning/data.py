@@ -198,7 +198,10 @@ class TensorBatches:
             ok[ok] &= frames.frame[ends[ok]] - frames.frame[ok] == sequence - 1  # no gaps
             starts = np.flatnonzero(ok)
             if len(starts) == 0:
-                raise ConfigError(f"no episode is {sequence} steps long; lower sequence_length")
+                raise ConfigError(
+                    f"no episode (nor, in a takeover dataset, a person's takeover) is {sequence} "
+                    "steps long; lower sequence_length"
+                )
         self.starts = torch.as_tensor(starts, device=device)
         self.offsets = torch.arange(sequence or 1, device=device)
         self.generator = torch.Generator(device="cpu").manual_seed(seed)
