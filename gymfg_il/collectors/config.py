@@ -29,7 +29,8 @@ class CollectConfig:
             task), level.
         dynamic: moving targets instead of fixed ones.
         episodes: episodes to record (manual: 0 = until you quit).
-        episode_time_s: seconds per episode.
+        episode_time_s: seconds per episode (default: the task's own: 90 for most, 120 for
+            waypoints, 180 for approach).
         agent_hz: agent rate = the dataset's fps, a divisor of 120.
         seed: seed of the first episode (episode i uses seed + i).
         noise: autopilot only: DART-style noise: std of Gaussian noise added to the executed
@@ -62,7 +63,7 @@ class CollectConfig:
     task: str = "altitude"
     dynamic: bool = False
     episodes: int = 10
-    episode_time_s: float = field(default=90.0, metadata={"flag": "--episode-time"})
+    episode_time_s: float | None = field(default=None, metadata={"flag": "--episode-time"})
     agent_hz: int = DEFAULT_AGENT_HZ
     seed: int = 0
     noise: float = 0.02
@@ -91,7 +92,9 @@ class CollectConfig:
             problems.append(f"device={self.device!r}: choose keyboard, mouse or joystick")
         if self.task in ("dummy",):
             problems.append("task 'dummy' has no controller to demonstrate it")
-        elif not (isinstance(self.episode_time_s, (int, float)) and self.episode_time_s > 0):
+        elif self.episode_time_s is not None and not (
+            isinstance(self.episode_time_s, (int, float)) and self.episode_time_s > 0
+        ):
             problems.append(f"episode_time_s={self.episode_time_s!r} must be > 0")
         else:
             try:

@@ -27,18 +27,39 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.tasks.orientation import bank_for_turn_rate
 
 _R2D = 57.29577951308232
+# a heading target turning faster than this jumped (a new target): no turn feed-forward
+MAX_FEED_FORWARD_TURN_DEG_S = 10.0
 
 
 @dataclass(frozen=True)
 class Targets:
-    """Where each target comes from: an observation name, a constant, or None (hold start)."""
+    """Where each target comes from: an observation name, a constant, or None (hold start).
+
+    ``relative``: names the axes (``vertical``, ``lateral``, ``speed``) whose source entry
+    holds the error (target minus value, wrapped for headings) instead of the target itself.
+    ``lateral="track"`` steers onto a line (a runway centre line, a slot beside a lead): the
+    source holds the line's course minus the heading and ``track_source`` how far right of
+    the line the aircraft is (ft); the heading target is the course turned towards the line
+    by ``track_gain`` degrees per ft, at most ``track_limit_deg``.
+    ``station_source`` keeps station on a moving point (a formation slot): it holds how far
+    behind the point the aircraft is (ft) and ``station_rate_source`` how fast that grows
+    (ft/s); the airspeed target is the airspeed plus ``station_gains`` (kt per ft, kt per
+    ft/s) times them, at most 20 kt either way.
+    """
 
     vertical: str = "altitude"  # "altitude", "pitch" or "climb"
     vertical_source: str | float | None = None
-    lateral: str = "roll"  # "roll" or "heading"
+    lateral: str = "roll"  # "roll", "heading" or "track"
     lateral_source: str | float | None = 0.0
     speed_source: str | float | None = None
     sideslip_source: str | float | None = None  # None: coordinated flight (zero sideslip)
+    relative: frozenset[str] = frozenset()
+    track_source: str | None = None
+    track_gain: float = 0.02
+    track_limit_deg: float = 30.0
+    station_source: str | None = None
+    station_rate_source: str | None = None
+    station_gains: tuple[float, float] = (0.4, 2.0)
 
 
 class Autopilot:
@@ -74,8 +95,12 @@ class Autopilot:
             "q_rad_s",
             "beta_deg",
         ]
-        if targets.lateral == "heading":
+        if targets.lateral in ("heading", "track"):
             need.append("heading_deg")
+        if targets.lateral == "track":
+            need.append(str(targets.track_source))
+        if targets.station_source is not None:
+            need += [targets.station_source, str(targets.station_rate_source)]
         for source in (targets.vertical_source, targets.lateral_source, targets.speed_source):
             if isinstance(source, str):
                 need.append(source)
@@ -146,12 +171,15 @@ class Autopilot:
     def set_throttle_trim(self, throttle: float) -> None:
         self.throttle_trim = throttle
 
-    def _value(self, obs: list[float], source: str | float | None, hold: str) -> float:
+    def _value(
+        self, obs: list[float], source: str | float | None, hold: str, axis: str = ""
+    ) -> float:
         if source is None:
             assert self.start is not None
             return self.start[self.index[hold]]
         if isinstance(source, str):
-            return obs[self.index[source]]
+            value = obs[self.index[source]]
+            return value + obs[self.index[hold]] if axis in self.targets.relative else value
         return float(source)
 
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
@@ -168,11 +196,14 @@ class Autopilot:
             if t.vertical == "climb":
                 climb_target = self._value(obs, t.vertical_source, "vertical_speed_fps")
             else:
-                alt_target = self._value(obs, t.vertical_source, "altitude_ft")
+                alt_target = self._value(obs, t.vertical_source, "altitude_ft", "vertical")
                 alt_error = alt_target - obs[i["altitude_ft"]]
-                # feed-forward: climb at the target's own rate while it moves
+                # feed-forward: climb at the target's own rate while it moves (a target that
+                # jumps faster than the aircraft can climb is a new target, not a moving one)
                 last, self._last_altitude_target = self._last_altitude_target, alt_target
                 target_rate = 0.0 if last is None else (alt_target - last) / dt
+                if abs(target_rate) > g.max_climb_fps:
+                    target_rate = 0.0
                 climb_target = g.altitude_to_climb * alt_error + target_rate
             climb_target = max(-g.max_descent_fps, min(g.max_climb_fps, climb_target))
             pitch_target = self.climb_pid(climb_target, obs[i["vertical_speed_fps"]], dt)
@@ -180,24 +211,35 @@ class Autopilot:
         self._load_integral("pitch", self.pitch_pid, obs, pitch_target - obs[i["pitch_deg"]])
         nose_up = self.pitch_pid(pitch_target, obs[i["pitch_deg"]], dt, obs[i["q_rad_s"]] * _R2D)
         # lateral: heading -> roll -> aileron
-        if t.lateral == "heading":
-            heading_target = self._value(obs, t.lateral_source, "heading_deg")
+        if t.lateral in ("heading", "track"):
+            heading_target = self._value(obs, t.lateral_source, "heading_deg", "lateral")
+            if t.lateral == "track":  # the line's course, turned towards the line
+                off = t.track_gain * obs[i[str(t.track_source)]]
+                heading_target -= max(-t.track_limit_deg, min(t.track_limit_deg, off))
             err = (heading_target - obs[i["heading_deg"]] + 180.0) % 360.0 - 180.0
-            # feed-forward: the bank of a coordinated turn at the target's own turn rate
+            # feed-forward: the bank of a coordinated turn at the target's own turn rate (a
+            # jump, such as the next gate's bearing, is a new target, not a turn)
             last, self._last_heading_target = self._last_heading_target, heading_target
             turn = 0.0 if last is None else ((heading_target - last + 180.0) % 360.0 - 180.0) / dt
+            if abs(turn) > MAX_FEED_FORWARD_TURN_DEG_S:
+                turn = 0.0
             roll_target = g.heading_to_roll * err + bank_for_turn_rate(turn, obs[i["airspeed_kts"]])
         else:
             roll_target = self._value(obs, t.lateral_source, "roll_deg")
         roll_target = (
             max(-g.max_roll_deg, min(g.max_roll_deg, roll_target))
-            if t.lateral == "heading"
+            if t.lateral != "roll"
             else roll_target
         )
         self._load_integral("roll", self.roll_pid, obs, roll_target - obs[i["roll_deg"]])
         aileron = self.roll_pid(roll_target, obs[i["roll_deg"]], dt, obs[i["p_rad_s"]] * _R2D)
         # speed: airspeed -> throttle; rudder: sideslip -> 0
-        speed_target = self._value(obs, t.speed_source, "airspeed_kts")
+        if t.station_source is not None:
+            kp, kd = t.station_gains
+            ask = kp * obs[i[t.station_source]] + kd * obs[i[str(t.station_rate_source)]]
+            speed_target = obs[i["airspeed_kts"]] + max(-20.0, min(20.0, ask))
+        else:
+            speed_target = self._value(obs, t.speed_source, "airspeed_kts", "speed")
         self._load_integral("speed", self.speed_pid, obs, speed_target - obs[i["airspeed_kts"]])
         throttle = self.speed_pid(speed_target, obs[i["airspeed_kts"]], dt)
         if t.sideslip_source is None:  # coordinated flight: sideslip to zero
@@ -206,6 +248,46 @@ class Autopilot:
             slip_target = self._value(obs, t.sideslip_source, "beta_deg")
             rudder = self.slip_pid(slip_target, obs[i["beta_deg"]], dt)
         return np.array([aileron, -nose_up, rudder, throttle])
+
+
+_BOTH = frozenset({"vertical", "lateral"})
+# The experts of the maneuvers (``tasks.maneuvers``, ``tasks.courses``): the same loops, fed
+# from the entries each maneuver observes.
+MANEUVER_TARGETS: dict[str, Targets] = {
+    "turn": Targets(
+        vertical_source="altitude_ft_error",
+        lateral="heading",
+        lateral_source="turn_remaining_deg",
+        relative=_BOTH,
+    ),
+    "climb-turn": Targets(
+        vertical_source="altitude_ft_target", lateral="heading", lateral_source="heading_deg_target"
+    ),
+    "waypoints": Targets(
+        vertical_source="gate_altitude_error_ft",
+        lateral="heading",
+        lateral_source="gate_bearing_error_deg",
+        relative=_BOTH,
+    ),
+    "approach": Targets(
+        vertical_source="glidepath_error_ft",
+        lateral="track",
+        lateral_source="course_error_deg",
+        track_source="centerline_offset_ft",
+        speed_source="airspeed_kts_error",
+        relative=_BOTH | {"speed"},
+    ),
+    "formation": Targets(
+        vertical_source="below_slot_ft",
+        lateral="track",
+        lateral_source="lead_heading_error_deg",
+        track_source="right_of_slot_ft",
+        track_gain=0.2,
+        station_source="behind_slot_ft",
+        station_rate_source="behind_slot_rate_fps",
+        relative=_BOTH,
+    ),
+}
 
 
 def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0.7) -> Autopilot:
@@ -227,6 +309,8 @@ def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0
             "airspeed": Targets(speed_source=source),
             "sideslip": Targets(sideslip_source=source),
         }[key]
+    elif getattr(task, "name", None) in MANEUVER_TARGETS:
+        targets = MANEUVER_TARGETS[task.name]  # type: ignore[attr-defined]
     elif isinstance(task, LevelFlightTask):
         targets = Targets(lateral="heading", lateral_source=None)
     elif isinstance(task, DummyTask):

@@ -127,13 +127,17 @@ class FlightSpec:
         task_kwargs: Mapping[str, Any] | None = None,
         agent_hz: int = DEFAULT_AGENT_HZ,
         sim_hz: int = DEFAULT_SIM_HZ,
-        episode_time_s: float = 90.0,
+        episode_time_s: float | None = None,
         turbulence: Turbulence = "none",
         wind_kt: float = 0.0,
         wind_from_deg: float | None = None,
     ) -> FlightSpec:
-        """One aircraft, callsign ``ego``, flying one task (what the gymnasium env flies)."""
+        """One aircraft, callsign ``ego``, flying one task (what the gymnasium env flies);
+        ``episode_time_s`` defaults to the task's own (90 s for most, longer for the
+        maneuvers that need it)."""
         ego = AircraftSpec(aircraft, "ego", task, dynamic, dict(task_kwargs or {}))
+        if episode_time_s is None:
+            episode_time_s = task_class(task, dynamic).episode_time_s
         teams = (TeamSpec("ego", (ego,)),)
         return cls(
             teams, agent_hz, sim_hz, episode_time_s, DEFAULT_OPPONENT_VIEW, None, turbulence,

@@ -18,6 +18,11 @@ IDS: dict[str, str] = {
     "GymFG/Sideslip-v0": "sideslip",
     "GymFG/LevelFlight-v0": "level",
     "GymFG/Dummy-v0": "dummy",
+    "GymFG/Turn-v0": "turn",
+    "GymFG/ClimbTurn-v0": "climb-turn",
+    "GymFG/Waypoints-v0": "waypoints",
+    "GymFG/Formation-v0": "formation",
+    "GymFG/Approach-v0": "approach",
 }
 
 

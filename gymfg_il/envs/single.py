@@ -36,7 +36,8 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         task_kwargs: arguments of the task class, e.g. ``{"target_range": (-500, 500)}``.
         agent_hz: agent rate (Hz), an exact divisor of ``sim_hz``.
         sim_hz: JSBSim rate (Hz).
-        episode_time_s: episode length; reaching it sets ``truncated``.
+        episode_time_s: episode length; reaching it sets ``truncated`` (default: the task's
+            own, 90 s for most tasks).
         views: UDP ports of FlightGear views of the aircraft (``viz.flightgear``); with a view
             attached the env runs at real time.
         turbulence, wind_kt, wind_from_deg: the weather (``sim.weather``): JSBSim's
@@ -68,7 +69,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         task_kwargs: Mapping[str, Any] | None = None,
         agent_hz: int = DEFAULT_AGENT_HZ,
         sim_hz: int = DEFAULT_SIM_HZ,
-        episode_time_s: float = 90.0,
+        episode_time_s: float | None = None,
         render_mode: str | None = None,
         views: Sequence[int] | None = None,
         turbulence: Turbulence = "none",
@@ -102,7 +103,9 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
                 spec = task
             else:
                 raise ConfigError(f"task={task!r} must be a family name, a Task class or instance")
-            team = Team("ego", [(Aircraft(aircraft, "ego"), spec)], episode_time_s=episode_time_s)
+            cls = task if isinstance(task, type) else type(task)
+            seconds = cls.episode_time_s if episode_time_s is None else episode_time_s
+            team = Team("ego", [(Aircraft(aircraft, "ego"), spec)], episode_time_s=seconds)
         self.aircraft = team.aircraft[0]
         self.world = World(
             [team],

@@ -14,9 +14,10 @@ from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.evaluation.runner import evaluate, flight_for
 from gymfg_il.evaluation.trace import Trace
 from gymfg_il.rollout.agents import AgentSpec
+from gymfg_il.tasks.library import MANEUVERS
 from gymfg_il.workers import Workers
 
-TASKS = ("altitude", "roll", "pitch", "heading", "airspeed", "sideslip", "level")
+TASKS = ("altitude", "roll", "pitch", "heading", "airspeed", "sideslip", "level", *MANEUVERS)
 
 
 @dataclass
@@ -154,6 +155,7 @@ def run_eval(
         run.written.append(cfg.json)
     if cfg.plots:
         from gymfg_il.evaluation.plots import figure1, primary_control
+        from gymfg_il.evaluation.tracks import ground_tracks, has_track
 
         label, model = flight.task_label.rsplit(":", 1)[-1], flight.aircraft
         for name, episodes in traces.items():
@@ -162,4 +164,9 @@ def run_eval(
             control = primary_control(episodes[0].variable)
             figure1(episodes[: cfg.plot_episodes], control, title, path)
             run.written.append(path)
+        first = next(iter(traces.values()))
+        if first and has_track(first[0]):  # gates, a runway, a lead: where, not when
+            path = cfg.plots / f"{label}_{model}_tracks.png"
+            title = f"{label} on {model}: ground track and vertical profile"
+            run.written.append(ground_tracks(traces, title, path, cfg.plot_episodes))
     return run

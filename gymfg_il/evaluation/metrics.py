@@ -3,7 +3,9 @@ control effort and smoothness.
 
 Definitions (per episode, then averaged over episodes):
 
-- success: the aircraft did not terminate and ``|error| <= tolerance`` held through the last
+- success: the aircraft did not terminate and, for a maneuver, the task's own judge passed the
+  flown states (``ManeuverTask.judge``); for the target tasks ``|error| <= tolerance`` held
+  through the last
   ``hold_s`` seconds (for dynamic targets the tolerance is ``tracking_factor`` x tolerance).
   In turbulence a gust carries any aircraft past a calm-air tolerance for a moment, so there
   the error must average within the tolerance over those seconds instead.
@@ -40,6 +42,7 @@ class EpisodeScore:
     control_effort: float
     smoothness: float
     terminated: bool
+    detail: str = ""  # a maneuver's judgement in words
 
 
 def score_episode(ep: Trace, hold_s: float = HOLD_S) -> EpisodeScore:
@@ -59,8 +62,11 @@ def score_episode(ep: Trace, hold_s: float = HOLD_S) -> EpisodeScore:
         total_return=ep.total_return,
         success=bool(
             not ep.terminated
-            and len(abs_err) >= hold
-            and (tail.mean() if ep.gusty else tail.max()) <= tolerance
+            and (
+                ep.verdict
+                if ep.verdict is not None
+                else len(abs_err) >= hold and (tail.mean() if ep.gusty else tail.max()) <= tolerance
+            )
         ),
         time_to_target_s=float((reached[0] + 1) * ep.dt) if len(reached) else math.nan,
         steady_state_error=float(tail.mean()) if len(tail) else math.nan,
@@ -68,6 +74,7 @@ def score_episode(ep: Trace, hold_s: float = HOLD_S) -> EpisodeScore:
         control_effort=float(np.abs(surfaces).mean()),
         smoothness=float(changes),
         terminated=ep.terminated,
+        detail=f"{ep.reason}" if ep.terminated else ep.detail,
     )
 
 

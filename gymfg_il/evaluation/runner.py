@@ -74,8 +74,8 @@ def flight_for(
                 "them separately"
             )
         rate = agent_hz or (rates.pop() if rates else DEFAULT_AGENT_HZ)
-        base = FlightSpec.solo(agent_hz=rate)
-        return base.replace(**{k: v for k, v in asked.items() if v is not None}), notes
+        given = {k: v for k, v in asked.items() if v is not None}
+        return FlightSpec.solo(agent_hz=rate, **given), notes
     path, base = next(iter(known.items()))
     if agent_hz is not None and agent_hz != base.agent_hz:
         raise ConfigError(

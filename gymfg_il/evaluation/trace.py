@@ -2,12 +2,14 @@
 
 A ``Trace`` is taken from a rollout ``Episode`` (``trace_of``): the task says which variable
 it brings to a target and which observation entry holds target minus value
-(``Task.tracked()``), and the observation after each step gives both.
+(``Task.tracked()``), and the observation after each step gives both. A maneuver also judges
+its own success from the flown states (``ManeuverTask.judge``); the trace keeps the verdict.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -36,6 +38,12 @@ class Trace:
     terminated: bool
     reason: str | None
     gusty: bool = False  # flown in turbulence: success is judged on the mean error
+    # a maneuver's own judgement (``ManeuverTask.judge``): success and what decided it
+    verdict: bool | None = None
+    detail: str = ""
+    # the catalogue states from the reset on (maneuvers: for ground tracks and profiles)
+    states: np.ndarray | None = None
+    plan: dict[str, Any] | None = None
 
     @property
     def time_s(self) -> np.ndarray:
@@ -56,6 +64,13 @@ def trace_of(episode: Episode, callsign: str | None = None, gusty: bool = False)
         raise ConfigError(f"task {task.get('task')!r} has no target to evaluate against")
     names = list(task["observation"])
     after = t.next_observations.astype(np.float64)
+    verdict, detail, states, plan = None, "", None, task.get("plan")
+    if plan is not None:
+        from gymfg_il.tasks.library import task_class
+
+        states = np.vstack([t.start.state[None], t.states])
+        judged = task_class(task["task"]).judge(plan, states, episode.dt)  # type: ignore[attr-defined]
+        verdict, detail = judged.success, judged.detail
     value = after[:, names.index(tracked["variable"])]
     error = after[:, names.index(tracked["error"])]
     return Trace(
@@ -72,4 +87,8 @@ def trace_of(episode: Episode, callsign: str | None = None, gusty: bool = False)
         terminated=t.terminated,
         reason=t.reason,
         gusty=gusty,
+        verdict=verdict,
+        detail=detail,
+        states=states,
+        plan=plan,
     )

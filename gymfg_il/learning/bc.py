@@ -28,7 +28,9 @@ class TrainConfig:
     Attributes:
         dataset: LeRobot dataset folder (default: the bundled sample).
         out: where the checkpoint goes (default: policies/bc-<task>-<aircraft>-<policy>).
-        policy: policy type: mlp (default) or gru (recurrent).
+        policy: policy type: mlp (default; one observation in, one action out), gru
+            (recurrent) or chunk (an observation history in, a chunk of future actions out,
+            flown with temporal ensembling, as ACT does).
         epochs: passes over the training frames (at 30, an F-15 altitude policy cloned from
             40 demonstrations held offsets of 12-50 ft and succeeded in 10 of 12 held-out
             episodes; at 60, in all of them).
@@ -40,6 +42,8 @@ class TrainConfig:
         device: cpu, cuda, or auto (cuda when present).
         hidden: hidden widths (mlp) or the GRU width (gru, first value).
         sequence_length: gru only: training window in steps.
+        history: chunk only: observations the policy sees (the current one and those before).
+        chunk: chunk only: actions predicted at every step.
         obs_noise: std of Gaussian noise added to the normalised observations while training
             (0 = none).
         threads: CPU threads torch uses on cpu (0 = torch's own choice). One is fastest for
@@ -48,7 +52,7 @@ class TrainConfig:
 
     dataset: Path = DEFAULT_DATASET
     out: Path | None = None
-    policy: Literal["mlp", "gru"] = "mlp"
+    policy: Literal["mlp", "gru", "chunk"] = "mlp"
     epochs: int = 60
     batch_size: int = 256
     lr: float = 1e-3
@@ -58,6 +62,8 @@ class TrainConfig:
     device: str = "cpu"
     hidden: list[int] = field(default_factory=lambda: [256, 256])
     sequence_length: int = 32
+    history: int = 4
+    chunk: int = 10
     obs_noise: float = 0.0
     threads: int = 1
 
@@ -67,8 +73,10 @@ class TrainConfig:
             raise ConfigError(join_problems("train config", typed))
         self.dataset = Path(self.dataset)
         problems = []
-        if self.policy not in ("mlp", "gru"):
-            problems.append(f"policy={self.policy!r}: choose mlp or gru")
+        if self.policy not in ("mlp", "gru", "chunk"):
+            problems.append(f"policy={self.policy!r}: choose mlp, gru or chunk")
+        if self.history < 1 or self.chunk < 1:
+            problems.append(f"history={self.history} and chunk={self.chunk} must be >= 1")
         if self.threads < 0:
             problems.append(f"threads={self.threads}: want 0 (torch decides) or more")
         if self.epochs < 1 or self.batch_size < 1:
@@ -178,19 +186,23 @@ def _train(
     _check_out(out)  # before training, not after
     train, val = split_by_episode(frames, cfg.val_fraction, cfg.seed)
     torch.manual_seed(cfg.seed)
+    sequence: int | None = None
+    chunks: tuple[int, int] | None = None
     if cfg.policy == "gru":
         pconf = make_config("gru", hidden=cfg.hidden[0], sequence_length=cfg.sequence_length)
-        sequence: int | None = cfg.sequence_length
+        sequence = cfg.sequence_length
+    elif cfg.policy == "chunk":
+        pconf = make_config("chunk", hidden=list(cfg.hidden), history=cfg.history, chunk=cfg.chunk)
+        chunks = (cfg.history, cfg.chunk)
     else:
         pconf = make_config("mlp", hidden=list(cfg.hidden))
-        sequence = None
     policy = make_policy(pconf, frames.obs_stats, frames.action_stats).to(device)
     policy.obs_noise = cfg.obs_noise
-    batches = TensorBatches(train, cfg.batch_size, device, sequence, cfg.seed)
+    batches = TensorBatches(train, cfg.batch_size, device, sequence, cfg.seed, chunks)
     val_batches = None
     if val:
         try:
-            val_batches = TensorBatches(val, 4096, device, sequence, cfg.seed)
+            val_batches = TensorBatches(val, 4096, device, sequence, cfg.seed, chunks)
         except ConfigError as err:  # held-out frames too short for a window: train on
             log.warning("no validation loss: the held-out episodes are too short (%s)", err)
     opt = torch.optim.AdamW(policy.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)

@@ -169,9 +169,33 @@ def split_by_episode(
     return frames.select(np.setdiff1d(ids, val)), frames.select(val)
 
 
+def chunk_indices(
+    frames: Frames, history: int, chunk: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For every frame: the indices of its observation history (the current frame last,
+    repeating the first frame of its stretch at the start), of its action chunk (the current
+    frame first), and which chunk entries lie inside its stretch. A stretch is a run of
+    consecutive frames of one episode (a takeover dataset has gaps)."""
+    n = len(frames)
+    breaks = np.ones(n, bool)
+    breaks[1:] = (frames.episode[1:] != frames.episode[:-1]) | (
+        frames.frame[1:] != frames.frame[:-1] + 1
+    )
+    first_of = np.flatnonzero(breaks)
+    stretch = np.cumsum(breaks) - 1
+    first = first_of[stretch]
+    last = np.append(first_of[1:] - 1, n - 1)[stretch]
+    i = np.arange(n)
+    past = np.maximum(i[:, None] - np.arange(history - 1, -1, -1), first[:, None])
+    ahead = i[:, None] + np.arange(chunk)
+    inside = ahead <= last[:, None]
+    return past, np.minimum(ahead, last[:, None]), inside
+
+
 class TensorBatches:
-    """Shuffled batches from tensors on ``device``: frames, or windows of ``sequence`` steps
-    that never cross an episode boundary."""
+    """Shuffled batches from tensors on ``device``: frames, windows of ``sequence`` steps
+    that never cross an episode boundary, or (``chunks`` = (history, chunk)) observation
+    histories with the action chunks that follow them (NaN past an episode's end)."""
 
     def __init__(
         self,
@@ -180,6 +204,7 @@ class TensorBatches:
         device: str = "cpu",
         sequence: int | None = None,
         seed: int = 0,
+        chunks: tuple[int, int] | None = None,
     ) -> None:
         import torch
 
@@ -188,6 +213,13 @@ class TensorBatches:
         self.action = torch.as_tensor(frames.action, device=device)
         self.batch_size = batch_size
         self.sequence = sequence
+        self.chunks = None
+        if chunks is not None:
+            past, ahead, inside = chunk_indices(frames, *chunks)
+            future = frames.action[ahead]
+            future[~inside] = np.nan
+            self.obs = self.obs[torch.as_tensor(past, device=device)]
+            self.action = torch.as_tensor(future, device=device)
         if sequence is None:
             starts: np.ndarray = np.arange(len(frames))
         else:

@@ -10,14 +10,16 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.policies.configuration_chunk import ChunkConfig
 from gymfg_il.policies.configuration_gru import GRUConfig
 from gymfg_il.policies.configuration_mlp import MLPConfig
 
-CONFIGS: dict[str, type] = {"mlp": MLPConfig, "gru": GRUConfig}
+PolicyConfig = MLPConfig | GRUConfig | ChunkConfig
+CONFIGS: dict[str, type] = {"mlp": MLPConfig, "gru": GRUConfig, "chunk": ChunkConfig}
 CONFIG_FILE, WEIGHTS_FILE = "config.json", "model.safetensors"
 
 
-def make_config(kind: str, **kwargs: Any) -> MLPConfig | GRUConfig:
+def make_config(kind: str, **kwargs: Any) -> PolicyConfig:
     try:
         cls = CONFIGS[kind]
     except KeyError:
@@ -26,7 +28,7 @@ def make_config(kind: str, **kwargs: Any) -> MLPConfig | GRUConfig:
 
 
 def make_policy(
-    config: MLPConfig | GRUConfig,
+    config: PolicyConfig,
     obs_stats: dict[str, np.ndarray],
     action_stats: dict[str, np.ndarray],
 ) -> Any:
@@ -35,6 +37,10 @@ def make_policy(
         from gymfg_il.policies.modeling_mlp import MLPPolicy
 
         return MLPPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
+    if config.type == "chunk":
+        from gymfg_il.policies.modeling_chunk import ChunkPolicy
+
+        return ChunkPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
     from gymfg_il.policies.modeling_gru import GRUPolicy
 
     return GRUPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]

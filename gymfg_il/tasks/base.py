@@ -52,6 +52,8 @@ class Task:
     _call: tuple[tuple[Any, ...], dict[str, Any]] = ((), {})
     observation_vars: ClassVar[tuple[str, ...]] = FLIGHT_VARS
     extra_names: ClassVar[tuple[str, ...]] = ()
+    # how long an episode of this task lasts unless the flight says otherwise (seconds)
+    episode_time_s: ClassVar[float] = 90.0
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Task:
         # the arguments of the construction, whatever the subclass takes: what a flight spec

@@ -235,6 +235,19 @@ TASK_FAMILIES: dict[str, tuple[type[Task], type[Task]]] = {
     "level": (LevelFlightTask, LevelFlightTask),
     "dummy": (DummyTask, DummyTask),
 }
+
+
+def _add_maneuvers() -> None:
+    from gymfg_il.tasks.courses import ApproachTask, WaypointsTask
+    from gymfg_il.tasks.formation import FormationTask
+    from gymfg_il.tasks.maneuvers import ClimbTurnTask, TurnTask
+
+    for cls in (TurnTask, ClimbTurnTask, WaypointsTask, FormationTask, ApproachTask):
+        TASK_FAMILIES[cls.name] = (cls, cls)
+
+
+_add_maneuvers()
+MANEUVERS = ("turn", "climb-turn", "waypoints", "formation", "approach")
 assert set(FAMILIES) <= set(TASK_FAMILIES)
 # other names people look for a family by (the paper names the rudder's controller)
 TASK_ALIASES = {"rudder": "sideslip"}

@@ -1,0 +1,249 @@
+"""Maneuvers flown over the ground: three gates in order, and an approach to a runway.
+
+Positions are local north/east feet from a point of the plan (``maneuvers.local_ft``); the
+plan records that point as latitude and longitude, so a judge needs nothing but the states.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.sim.properties import INDEX
+from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft, wrap
+from gymfg_il.tasks.rewards import closeness
+
+_ALT, _HDG, _VC = INDEX["altitude_ft"], INDEX["heading_deg"], INDEX["airspeed_kts"]
+_LAT, _LON = INDEX["lat_deg"], INDEX["lon_deg"]
+FT_PER_NM = 6076.12
+KTS_TO_FPS = 1.6878098571011957
+
+
+class WaypointsTask(ManeuverTask):
+    """Fly through three gates in order.
+
+    Observation: ``FLIGHT_VARS`` and ``heading_deg``, then:
+
+    | entry | unit | meaning |
+    | --- | --- | --- |
+    | gate_distance_ft | ft | horizontal distance to the next gate (0 once all are passed) |
+    | gate_bearing_error_deg | deg | bearing of the next gate - heading (after the last: the last leg's course - heading) |
+    | gate_altitude_error_ft | ft | the next gate's altitude - altitude |
+    | next_turn_deg | deg | the turn at the next gate onto the leg after it (0 at the last) |
+    | gates_left | 1 | gates still to pass (3, 2, 1, 0) |
+
+    Plan: three gates, each 25-32 s of cruise flight from the one before (about 1.5 km for
+    the c172p, 6 km for the F-15), the first leg within 45 deg of the start heading, each
+    later leg turned 20-60 deg either way, each gate 0-300 ft above or below the one before.
+    A gate is passed within ``radius_ft`` (300) horizontally and ``altitude_tolerance_ft``
+    (150) vertically. Reward: ``0.5 exp(-distance / 3000) + 0.3 exp(-|altitude error| / 150)
+    + 0.2 exp(-|bearing error| / 20)`` minus the smoothness term. Success: all three gates
+    passed, in order.
+    Start and end: as every maneuver (module docstring); 120 s episodes.
+    """
+
+    name = "waypoints"
+    episode_time_s = 120.0
+    extra_names = (
+        "gate_distance_ft",
+        "gate_bearing_error_deg",
+        "gate_altitude_error_ft",
+        "next_turn_deg",
+        "gates_left",
+    )
+    tracked_entry = ("altitude_ft", "gate_altitude_error_ft", 150.0)
+    radius_ft = 300.0
+    altitude_tolerance_ft = 150.0
+
+    def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
+        speed = self._profile().cruise_kts * KTS_TO_FPS
+        course = float(state[_HDG]) + float(rng.uniform(-45.0, 45.0))
+        north = east = 0.0
+        alt = float(state[_ALT])
+        gates = []
+        for k in range(3):
+            if k:
+                course += float(rng.uniform(20.0, 60.0)) * (1.0 if rng.random() < 0.5 else -1.0)
+            leg = speed * float(rng.uniform(25.0, 32.0))
+            north += leg * math.cos(math.radians(course))
+            east += leg * math.sin(math.radians(course))
+            alt += float(rng.uniform(-300.0, 300.0))
+            gates.append([north, east, alt])
+        return {
+            "origin": [float(state[_LAT]), float(state[_LON])],
+            "gates": gates,
+            "radius_ft": self.radius_ft,
+            "altitude_tolerance_ft": self.altitude_tolerance_ft,
+        }
+
+    @staticmethod
+    def _inside(gate: list[float], north: Any, east: Any, alt: Any, plan: dict[str, Any]) -> Any:
+        horizontal = np.hypot(gate[0] - north, gate[1] - east) <= plan["radius_ft"]
+        return horizontal & (np.abs(gate[2] - alt) <= plan["altitude_tolerance_ft"])
+
+    def extras(self, state: np.ndarray, step: int) -> list[float]:
+        plan = self.plan
+        gates = plan["gates"]
+        north, east = local_ft(state, plan["origin"])
+        alt, heading = float(state[_ALT]), float(state[_HDG])
+        if step == 0:
+            self._gate = 0
+        if self._gate < len(gates) and self._inside(gates[self._gate], north, east, alt, plan):
+            self._gate += 1
+        k = self._gate
+        if k == len(gates):  # all passed: hold the last leg's course and the last altitude
+            (n0, e0, _), (n1, e1, a1) = gates[-2], gates[-1]
+            course = math.degrees(math.atan2(e1 - e0, n1 - n0))
+            return [0.0, wrap(course - heading), a1 - alt, 0.0, 0.0]
+        gn, ge, ga = gates[k]
+        bearing = math.degrees(math.atan2(ge - east, gn - north))
+        turn = 0.0
+        if k + 1 < len(gates):
+            nn, ne, _ = gates[k + 1]
+            turn = wrap(math.degrees(math.atan2(ne - ge, nn - gn)) - bearing)
+        distance = math.hypot(gn - north, ge - east)
+        return [distance, wrap(bearing - heading), ga - alt, turn, float(len(gates) - k)]
+
+    def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
+        return (
+            0.5 * closeness(extras[0], 3000.0)
+            + 0.3 * closeness(extras[2], 150.0)
+            + 0.2 * closeness(extras[1], 20.0)
+        )
+
+    @classmethod
+    def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
+        north, east = local_ft(states, plan["origin"])
+        alt = states[:, _ALT]
+        at = 0
+        for k, gate in enumerate(plan["gates"]):
+            inside = np.flatnonzero(cls._inside(gate, north[at:], east[at:], alt[at:], plan))
+            if not len(inside):
+                closest = np.hypot(gate[0] - north[at:], gate[1] - east[at:]).min()
+                return Verdict(
+                    False, f"passed {k} of 3 gates; gate {k + 1} missed by {closest:.0f} ft"
+                )
+            at += int(inside[0]) + 1  # one gate per step, as flown
+        return Verdict(True, f"all 3 gates passed, the last at {(at - 1) * dt:.1f} s")
+
+
+class ApproachTask(ManeuverTask):
+    """Capture and hold a 3 degree glide path and the runway centre line down to 200 ft above
+    the threshold, at the approach speed.
+
+    Observation: ``FLIGHT_VARS`` and ``heading_deg``, then:
+
+    | entry | unit | meaning |
+    | --- | --- | --- |
+    | distance_ft | ft | distance to the threshold along the runway course (positive before it) |
+    | centerline_offset_ft | ft | how far right of the extended centre line |
+    | course_error_deg | deg | runway course - heading, wrapped |
+    | glidepath_error_ft | ft | the glide path's altitude here - altitude (the path levels at 200 ft above the threshold) |
+    | airspeed_kts_error | kt | approach speed - airspeed |
+    | height_above_threshold_ft | ft | altitude - threshold elevation |
+
+    Plan: a runway whose course is within 30 deg of the start heading, its threshold 3.5-4
+    NM ahead along the course, the aircraft up to 1,500 ft either side of the centre line and
+    0-300 ft below (or up to 100 ft above) the glide path; approach speed 1.4 x the
+    aircraft's stall speed (70 kt for the c172p). Reward: ``0.4 exp(-|glide path error| /
+    100) + 0.4 exp(-|offset| / 300) + 0.2 exp(-|speed error| / 10)`` minus the smoothness term.
+    Success: the aircraft reaches the decision height (200 ft above the threshold on the
+    path), and from 2.5 NM out down to it stays within 100 ft of the glide path, 200 ft of
+    the centre line and 10 kt of the approach speed.
+    Start and end: as every maneuver (module docstring); 180 s episodes.
+    """
+
+    name = "approach"
+    episode_time_s = 180.0
+    extra_names = (
+        "distance_ft",
+        "centerline_offset_ft",
+        "course_error_deg",
+        "glidepath_error_ft",
+        "airspeed_kts_error",
+        "height_above_threshold_ft",
+    )
+    tracked_entry = ("altitude_ft", "glidepath_error_ft", 100.0)
+    glide_deg = 3.0
+    decision_height_ft = 200.0
+    hold_from_nm = 2.5
+    tolerances = {"glide path": 100.0, "centre line": 200.0, "airspeed": 10.0}  # noqa: RUF012
+
+    def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
+        course = (float(state[_HDG]) + float(rng.uniform(-30.0, 30.0))) % 360.0
+        distance = float(rng.uniform(3.5, 4.0)) * FT_PER_NM
+        offset = float(rng.uniform(-1500.0, 1500.0))
+        c, s = math.cos(math.radians(course)), math.sin(math.radians(course))
+        north, east = distance * c + offset * s, distance * s - offset * c
+        lat0, lon0 = float(state[_LAT]), float(state[_LON])
+        from gymfg_il.tasks.geometry import offset_position
+
+        lat, lon = offset_position(lat0, lon0, north, east)
+        tan = math.tan(math.radians(self.glide_deg))
+        below = float(rng.uniform(-100.0, 300.0))
+        return {
+            "threshold": [lat, lon],
+            "course_deg": course,
+            "threshold_ft": float(state[_ALT]) - distance * tan - below,
+            "glide_deg": self.glide_deg,
+            "approach_kts": round(1.4 * self._profile().min_airspeed_kts, 1),
+            "decision_height_ft": self.decision_height_ft,
+            "hold_from_ft": self.hold_from_nm * FT_PER_NM,
+        }
+
+    @staticmethod
+    def geometry(plan: dict[str, Any], states: np.ndarray) -> dict[str, Any]:
+        """Distance, offset and glide-path error of ``states`` (arrays or one state)."""
+        north, east = local_ft(states, plan["threshold"])
+        c = math.cos(math.radians(plan["course_deg"]))
+        s = math.sin(math.radians(plan["course_deg"]))
+        along = -(north * c + east * s)
+        tan = math.tan(math.radians(plan["glide_deg"]))
+        path = plan["threshold_ft"] + np.maximum(plan["decision_height_ft"], along * tan)
+        return {
+            "distance": along,
+            "offset": -north * s + east * c,
+            "glidepath": path - states[..., _ALT],
+            "airspeed": plan["approach_kts"] - states[..., _VC],
+        }
+
+    def extras(self, state: np.ndarray, step: int) -> list[float]:
+        plan = self.plan
+        g = self.geometry(plan, state)
+        return [
+            float(g["distance"]),
+            float(g["offset"]),
+            wrap(plan["course_deg"] - float(state[_HDG])),
+            float(g["glidepath"]),
+            float(g["airspeed"]),
+            float(state[_ALT]) - plan["threshold_ft"],
+        ]
+
+    def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
+        return (
+            0.4 * closeness(extras[3], 100.0)
+            + 0.4 * closeness(extras[1], 300.0)
+            + 0.2 * closeness(extras[4], 10.0)
+        )
+
+    @classmethod
+    def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
+        g = cls.geometry(plan, states)
+        tan = math.tan(math.radians(plan["glide_deg"]))
+        at_dh = plan["decision_height_ft"] / tan
+        reached = np.flatnonzero(g["distance"] <= at_dh)
+        if not len(reached):
+            left = (g["distance"][-1] - at_dh) / FT_PER_NM
+            return Verdict(False, f"ended {left:.2f} NM short of the decision height")
+        flown = slice(0, int(reached[0]) + 1)
+        final = g["distance"][flown] <= plan["hold_from_ft"]
+        for key, what in (("glidepath", "glide path"), ("offset", "centre line")):
+            worst = float(np.abs(g[key][flown][final]).max())
+            if worst > cls.tolerances[what]:
+                return Verdict(False, f"{worst:.0f} ft off the {what} on final")
+        worst = float(np.abs(g["airspeed"][flown][final]).max())
+        if worst > cls.tolerances["airspeed"]:
+            return Verdict(False, f"{worst:.1f} kt off the approach speed on final")
+        return Verdict(True, f"decision height at {reached[0] * dt:.1f} s, on the path")

@@ -1,0 +1,196 @@
+"""Formation: hold a slot behind and beside a lead aircraft that an autopilot flies through
+heading and altitude changes.
+
+The lead is a second JSBSim aircraft of the same model. Its flight does not depend on the
+follower's, so the task flies it whole at reset (its own simulation, its own autopilot, the
+seed's schedule of headings and altitudes) and the follower sees it step by step as an
+opponent is seen: position and orientation only. The plan records the lead's track, so a
+log, a dataset's episode or a judge has both aircraft.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.sim.initial import InitialConditions
+from gymfg_il.sim.properties import INDEX, indices
+from gymfg_il.tasks.base import FLIGHT_VARS
+from gymfg_il.tasks.geometry import offset_position
+from gymfg_il.tasks.maneuvers import FT_PER_DEG, ManeuverTask, Verdict, wrap
+from gymfg_il.tasks.rewards import closeness
+
+LEAD_VIEW = ("lat_deg", "lon_deg", "altitude_ft", "roll_deg", "pitch_deg", "heading_deg")
+_LEAD_IDX = indices(LEAD_VIEW)
+_ALT, _HDG = INDEX["altitude_ft"], INDEX["heading_deg"]
+_LAT, _LON = INDEX["lat_deg"], INDEX["lon_deg"]
+_LEAD_OBS = (*FLIGHT_VARS, "heading_deg", "altitude_ft_target", "heading_deg_target")
+
+
+def _lead_schedule(
+    rng: np.random.Generator, steps: int, dt: float, altitude: float, heading: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The lead's altitude and heading targets per step: straight for 10 s, then every 20-25
+    s a new heading (20-60 deg either way, turned at 3 deg/s) and altitude (100-300 ft either
+    way, at 5 ft/s)."""
+    alt_t, hdg_t = np.empty(steps + 1), np.empty(steps + 1)
+    alt_goal, hdg_goal = altitude, heading
+    next_change = 10.0
+    for i in range(steps + 1):
+        t = i * dt
+        if t >= next_change:
+            hdg_goal += float(rng.uniform(20.0, 60.0)) * (1.0 if rng.random() < 0.5 else -1.0)
+            alt_goal += float(rng.uniform(100.0, 300.0)) * (1.0 if rng.random() < 0.5 else -1.0)
+            next_change = t + float(rng.uniform(20.0, 25.0))
+        heading += max(-3.0 * dt, min(3.0 * dt, hdg_goal - heading))
+        altitude += max(-5.0 * dt, min(5.0 * dt, alt_goal - altitude))
+        alt_t[i], hdg_t[i] = altitude, heading % 360.0
+    return alt_t, hdg_t
+
+
+class FormationTask(ManeuverTask):
+    """Hold a slot 150 ft behind and 100 ft right of a lead aircraft, at its altitude.
+
+    Observation: ``FLIGHT_VARS`` and ``heading_deg``, then (from the lead's position and
+    orientation alone, as an opponent is seen):
+
+    | entry | unit | meaning |
+    | --- | --- | --- |
+    | behind_slot_ft | ft | how far behind the slot, along the lead's heading |
+    | behind_slot_rate_fps | ft/s | how fast that grows (from the last two steps) |
+    | right_of_slot_ft | ft | how far right of the slot |
+    | below_slot_ft | ft | the slot's altitude - altitude |
+    | lead_heading_error_deg | deg | the lead's heading - heading, wrapped |
+    | lead_roll_deg, lead_pitch_deg | deg | the lead's attitude |
+
+    Plan: the lead (same model) starts 250-450 ft ahead at 95 % of cruise speed, the
+    follower up to 100 ft either side of and above or below the slot's line; the lead flies
+    straight for 10 s, then every 20-25 s turns 20-60 deg (at 3 deg/s) and climbs or descends
+    100-300 ft (at 5 ft/s). Reward: ``exp(-distance to the slot / 100)`` minus the
+    smoothness term. Success: from 30 s on, within ``tolerance_ft`` (100) of the slot at
+    every step, and never within 50 ft of the lead.
+    Start and end: as every maneuver (module docstring); 90 s episodes.
+    """
+
+    name = "formation"
+    slot = (150.0, 100.0)  # behind, right of the lead (ft)
+    extra_names = (
+        "behind_slot_ft",
+        "behind_slot_rate_fps",
+        "right_of_slot_ft",
+        "below_slot_ft",
+        "lead_heading_error_deg",
+        "lead_roll_deg",
+        "lead_pitch_deg",
+    )
+    tracked_entry = ("altitude_ft", "below_slot_ft", 100.0)
+    join_s = 30.0
+    tolerance_ft = 100.0
+    min_separation_ft = 50.0
+
+    def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
+        profile = self._profile()
+        heading = float(state[_HDG])
+        gap = float(rng.uniform(100.0, 300.0))
+        side, up = float(rng.uniform(-100.0, 100.0)), float(rng.uniform(-100.0, 100.0))
+        ahead, left = self.slot[0] + gap, self.slot[1] + side
+        h = math.radians(heading)
+        north = ahead * math.cos(h) + left * math.sin(h)
+        east = ahead * math.sin(h) - left * math.cos(h)
+        lat, lon = offset_position(float(state[_LAT]), float(state[_LON]), north, east)
+        speed = 0.95 * profile.cruise_kts
+        ic = InitialConditions(lat, lon, float(state[_ALT]) - up, heading, speed)
+        alt_t, hdg_t = _lead_schedule(rng, self.max_steps, self.dt, ic.altitude_ft, heading)
+        track = self._fly_lead(ic, alt_t, hdg_t, speed)
+        return {"slot_ft": list(self.slot), "lead": np.round(track, 8).tolist()}
+
+    def _fly_lead(
+        self, ic: InitialConditions, alt_t: np.ndarray, hdg_t: np.ndarray, speed: float
+    ) -> np.ndarray:
+        """The lead's (lat, lon, altitude, roll, pitch, heading) at every step."""
+        from gymfg_il.controllers.autopilot import Autopilot, Targets
+        from gymfg_il.sim.simulation import Simulation
+
+        assert self.aircraft is not None
+        model, hz = self.aircraft.model, round(1.0 / self.dt)
+        sim = getattr(self, "_lead_sim", None)
+        if sim is None or sim.model != model or sim.agent_hz != hz:
+            self._lead_sim = sim = Simulation(model, agent_hz=hz)
+        targets = Targets(
+            vertical_source="altitude_ft_target",
+            lateral="heading",
+            lateral_source="heading_deg_target",
+            speed_source=speed,
+        )
+        pilot = Autopilot(_LEAD_OBS, model, self.dt, targets)
+        throttle = self._profile().cruise_throttle
+        pilot.set_throttle_trim(throttle)
+        state = sim.reset(ic, throttle)
+        own = indices((*FLIGHT_VARS, "heading_deg"))
+        track = np.empty((len(alt_t), len(LEAD_VIEW)))
+        for i in range(len(alt_t)):
+            track[i] = state[_LEAD_IDX]
+            if i + 1 < len(alt_t):
+                obs = np.append(state[own], (alt_t[i], hdg_t[i]))
+                sim.apply(*np.clip(pilot.act(obs), [-1, -1, -1, 0], [1, 1, 1, 1]))
+                state = sim.read()
+        return track
+
+    @classmethod
+    def geometry(
+        cls, plan: dict[str, Any], states: np.ndarray, steps: np.ndarray
+    ) -> dict[str, np.ndarray]:
+        """Where ``states`` (rows, at agent ``steps``) are from the slot and the lead."""
+        lead = np.asarray(plan["lead"])[np.minimum(steps, len(plan["lead"]) - 1)]
+        cos_lat = math.cos(math.radians(float(lead[0, 0])))
+        north = (states[:, _LAT] - lead[:, 0]) * FT_PER_DEG
+        east = wrap(states[:, _LON] - lead[:, 1]) * FT_PER_DEG * cos_lat
+        h = np.radians(lead[:, 5])
+        fwd = north * np.cos(h) + east * np.sin(h)  # ahead of the lead (ft)
+        right = -north * np.sin(h) + east * np.cos(h)
+        behind, right_of = plan["slot_ft"]
+        return {
+            "behind": -(fwd + behind),
+            "right": right - right_of,
+            "below": lead[:, 2] - states[:, _ALT],
+            "separation": np.sqrt(north**2 + east**2 + (lead[:, 2] - states[:, _ALT]) ** 2),
+            "lead": lead,
+        }
+
+    def extras(self, state: np.ndarray, step: int) -> list[float]:
+        g = self.geometry(self.plan, state[None], np.array([step]))
+        behind = float(g["behind"][0])
+        if step == 0:
+            self._last_behind = behind
+        rate, self._last_behind = (behind - self._last_behind) / self.dt, behind
+        lead = g["lead"][0]
+        return [
+            behind,
+            rate,
+            float(g["right"][0]),
+            float(g["below"][0]),
+            wrap(float(lead[5]) - float(state[_HDG])),
+            float(lead[3]),
+            float(lead[4]),
+        ]
+
+    def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
+        return closeness(math.sqrt(extras[0] ** 2 + extras[2] ** 2 + extras[3] ** 2), 100.0)
+
+    @classmethod
+    def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
+        g = cls.geometry(plan, states, np.arange(len(states)))
+        closest = float(g["separation"].min())
+        if closest < cls.min_separation_ft:
+            return Verdict(False, f"came within {closest:.0f} ft of the lead")
+        off = np.sqrt(g["behind"] ** 2 + g["right"] ** 2 + g["below"] ** 2)
+        held = off[round(cls.join_s / dt) :]
+        if not len(held):
+            return Verdict(False, f"ended before {cls.join_s:g} s")
+        worst = int(held.argmax())
+        if held[worst] > cls.tolerance_ft:
+            when = (worst + round(cls.join_s / dt)) * dt
+            return Verdict(False, f"{held[worst]:.0f} ft from the slot at {when:.1f} s")
+        return Verdict(True, f"in the slot from {cls.join_s:g} s, at most {held.max():.0f} ft off")

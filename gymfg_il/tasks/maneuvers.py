@@ -1,0 +1,254 @@
+"""Maneuvers: tasks that need a pilot rather than one loop to one target.
+
+Each episode draws a *plan* from the seed (a turn, a pair of targets, three gates, a runway)
+at reset; ``describe()["plan"]`` records it, and the task's ``judge(plan, states, dt)`` says
+from the flown states alone whether the maneuver succeeded and, if not, why. Evaluation scores
+success with the task's own rule, so a dataset, a log or an eval row is judged the same way.
+
+Every maneuver observes ``FLIGHT_VARS`` and ``heading_deg`` first, then its own entries (see
+each task's table). Start: the aircraft's cruise profile (altitude +/- 500 ft, any heading,
+airspeed +/- 5 %, wings level). End: as every task (crash, stall, ceiling: ``terminated``;
+the episode time, each task's own ``episode_time_s`` unless the flight sets one:
+``truncated``). The action is ``[aileron, elevator, rudder, throttle]``.
+
+This module holds the shared machinery and the turn tasks; ``tasks.courses`` holds the tasks
+flown over the ground (waypoints, approach) and ``tasks.formation`` the formation slot.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from gymfg_il.sim.properties import INDEX
+from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.rewards import RewardContext, action_change, closeness
+
+HOLD_S = 10.0  # the last seconds over which a maneuver's end state must hold
+SMOOTHNESS_WEIGHT = 0.05
+_ALT, _HDG = INDEX["altitude_ft"], INDEX["heading_deg"]
+FT_PER_DEG = math.pi / 180.0 * 20902230.97  # feet per degree of latitude (mean Earth radius)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """A task's judgement of one flown episode: success, and in words what decided it."""
+
+    success: bool
+    detail: str
+
+
+def wrap(angle: Any) -> Any:
+    """Angles (scalars or arrays) folded into [-180, 180)."""
+    return (angle + 180.0) % 360.0 - 180.0
+
+
+def local_ft(states: np.ndarray, origin: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """(north, east) in ft of catalogue-ordered ``states`` (rows) from ``origin`` (lat, lon),
+    on a flat earth around the origin (errors below 0.1 % over the few miles a task spans)."""
+    lat = states[..., INDEX["lat_deg"]]
+    lon = states[..., INDEX["lon_deg"]]
+    north = (lat - origin[0]) * FT_PER_DEG
+    east = wrap(lon - origin[1]) * FT_PER_DEG * math.cos(math.radians(origin[0]))
+    return north, east
+
+
+def hold_steps(dt: float) -> int:
+    return max(1, round(HOLD_S / dt))
+
+
+def _signed(rng: np.random.Generator, low: float, high: float) -> float:
+    """A magnitude drawn from [low, high) with a random sign."""
+    return float(rng.uniform(low, high)) * (1.0 if rng.random() < 0.5 else -1.0)
+
+
+class ManeuverTask(Task):
+    """Shared machinery: a plan drawn at reset, extra observation entries computed once per
+    step from the state and the task's memory, and a judge of flown states."""
+
+    observation_vars = (*FLIGHT_VARS, "heading_deg")
+    episode_time_s: ClassVar[float] = 90.0
+    # (variable, observation entry of target minus value, tolerance): what plots draw
+    tracked_entry: ClassVar[tuple[str, str, float]] = ("heading_deg", "heading_deg_error", 3.0)
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.plan: dict[str, Any] = {}
+        self._step = -1
+        self._extras = np.zeros(len(self.extra_names))
+
+    def _extra_bounds(self) -> tuple[list[float], list[float]]:
+        n = len(self.extra_names)
+        return [-1e6] * n, [1e6] * n
+
+    # -- what each maneuver defines --------------------------------------------------------
+    def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def extras(self, state: np.ndarray, step: int) -> list[float]:
+        """The task's observation entries at ``step`` (called once per step, in order, so it
+        may keep memory such as the gate reached)."""
+        raise NotImplementedError
+
+    def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
+        """The reward's task term (at most 1) from this step's entries."""
+        raise NotImplementedError
+
+    @classmethod
+    def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
+        """Whether ``states`` (catalogue order, the reset state first) fly the maneuver."""
+        raise NotImplementedError
+
+    # -- the Task hooks ------------------------------------------------------------------
+    def reset(self, state: np.ndarray, rng: np.random.Generator) -> None:
+        self.plan = self.draw_plan(state, rng)
+        self._step = -1
+        self._sync(state, 0)  # the memory starts here, whoever asks first
+
+    def _sync(self, state: np.ndarray, step: int) -> np.ndarray:
+        if step != self._step:
+            self._extras = np.asarray(self.extras(state, step), np.float64)
+            self._step = step
+        return self._extras
+
+    def observe(self, state: np.ndarray, step: int) -> np.ndarray:
+        n = self._n_vars
+        extras = self._sync(state, step)
+        obs = np.empty(n + len(extras), np.float32)
+        obs[:n] = state[self._obs_idx]
+        obs[n:] = extras
+        return obs
+
+    def task_reward(self, ctx: RewardContext) -> float:
+        state = ctx.state.values
+        extras = self._sync(state, ctx.step)
+        smooth = action_change(ctx.prev_action, ctx.action)
+        return self.shaped(extras, state) - SMOOTHNESS_WEIGHT * smooth
+
+    def tracked(self) -> dict[str, Any]:
+        variable, error, tolerance = self.tracked_entry
+        return {"variable": variable, "error": error, "tolerance": tolerance, "dynamic": True}
+
+    def describe(self) -> dict[str, Any]:
+        return {**super().describe(), "plan": dict(self.plan), "maneuver": True}
+
+
+class TurnTask(ManeuverTask):
+    """Turn by 60-180 degrees either way and roll out on the new heading, holding altitude.
+
+    Observation: ``FLIGHT_VARS`` and ``heading_deg``, then:
+
+    | entry | unit | meaning |
+    | --- | --- | --- |
+    | turn_remaining_deg | deg | the turn still to fly (positive: right), unwrapped |
+    | altitude_ft_error | ft | start altitude - altitude |
+    | altitude_ft_error_integral | ft·s | that error summed over the steps times dt (at most +/- 60 s of 1,000 ft) |
+
+    Plan: the turn (magnitude drawn from [60, 180) deg, either way) and the start altitude.
+    Reward: ``0.6 exp(-|remaining| / 30) + 0.4 exp(-|altitude error| / 100)`` minus the usual
+    smoothness term. Success: the altitude stays within 100 ft of the start throughout and
+    the heading is within 5 deg of the new one over the last 10 s.
+    Start and end: as every maneuver (module docstring); 90 s episodes.
+    """
+
+    name = "turn"
+    extra_names = ("turn_remaining_deg", "altitude_ft_error", "altitude_ft_error_integral")
+    tracked_entry = ("heading_deg", "turn_remaining_deg", 5.0)
+    altitude_tolerance = 100.0
+    heading_tolerance = 5.0
+
+    def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
+        return {
+            "turn_deg": _signed(rng, 60.0, 180.0),
+            "start_heading_deg": float(state[_HDG]),
+            "altitude_ft": float(state[_ALT]),
+        }
+
+    def extras(self, state: np.ndarray, step: int) -> list[float]:
+        heading = float(state[_HDG])
+        if step == 0:
+            self._turned, self._last, self._integral = 0.0, heading, 0.0
+        self._turned += wrap(heading - self._last)
+        self._last = heading
+        alt_err = self.plan["altitude_ft"] - float(state[_ALT])
+        if step:
+            self._integral = max(-6e4, min(6e4, self._integral + alt_err * self.dt))
+        return [self.plan["turn_deg"] - self._turned, alt_err, self._integral]
+
+    def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
+        return 0.6 * closeness(extras[0], 30.0) + 0.4 * closeness(extras[1], 100.0)
+
+    @classmethod
+    def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
+        turned = np.unwrap(states[:, _HDG], period=360.0)
+        turned = turned - turned[0]
+        alt_err = np.abs(states[:, _ALT] - plan["altitude_ft"])
+        worst = int(alt_err.argmax())
+        if alt_err[worst] > cls.altitude_tolerance:
+            return Verdict(False, f"altitude off by {alt_err[worst]:.0f} ft at {worst * dt:.1f} s")
+        tail = np.abs(plan["turn_deg"] - turned[-hold_steps(dt) :])
+        if len(states) <= hold_steps(dt) or tail.max() > cls.heading_tolerance:
+            return Verdict(False, f"heading off the new one by up to {tail.max():.1f} deg at the end")
+        return Verdict(True, f"turned {turned[-1]:+.0f} of {plan['turn_deg']:+.0f} deg")
+
+
+class ClimbTurnTask(ManeuverTask):
+    """Reach a new altitude and a new heading together.
+
+    Observation: ``FLIGHT_VARS`` and ``heading_deg``, then:
+
+    | entry | unit | meaning |
+    | --- | --- | --- |
+    | altitude_ft_target | ft | the new altitude |
+    | altitude_ft_error | ft | target - altitude |
+    | altitude_ft_error_integral | ft·s | that error summed over the steps times dt |
+    | heading_deg_target | deg | the new heading |
+    | heading_deg_error | deg | target - heading, wrapped to [-180, 180) |
+
+    Plan: an altitude change of 300-1,000 ft and a heading change of 30-90 deg, each either
+    way. Reward: ``0.5 exp(-|altitude error| / 200) + 0.5 exp(-|heading error| / 10)`` minus
+    the smoothness term. Success: within 50 ft and 3 deg of both over the last 10 s.
+    Start and end: as every maneuver (module docstring); 90 s episodes.
+    """
+
+    name = "climb-turn"
+    extra_names = (
+        "altitude_ft_target",
+        "altitude_ft_error",
+        "altitude_ft_error_integral",
+        "heading_deg_target",
+        "heading_deg_error",
+    )
+    tracked_entry = ("altitude_ft", "altitude_ft_error", 50.0)
+    altitude_tolerance = 50.0
+    heading_tolerance = 3.0
+
+    def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
+        return {
+            "altitude_ft": float(state[_ALT]) + _signed(rng, 300.0, 1000.0),
+            "heading_deg": (float(state[_HDG]) + _signed(rng, 30.0, 90.0)) % 360.0,
+        }
+
+    def extras(self, state: np.ndarray, step: int) -> list[float]:
+        alt_err = self.plan["altitude_ft"] - float(state[_ALT])
+        if step == 0:
+            self._integral = 0.0
+        else:
+            self._integral = max(-6e4, min(6e4, self._integral + alt_err * self.dt))
+        hdg = self.plan["heading_deg"]
+        return [self.plan["altitude_ft"], alt_err, self._integral, hdg, wrap(hdg - state[_HDG])]
+
+    def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
+        return 0.5 * closeness(extras[1], 200.0) + 0.5 * closeness(extras[4], 10.0)
+
+    @classmethod
+    def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
+        tail = states[-hold_steps(dt) :]
+        alt = np.abs(plan["altitude_ft"] - tail[:, _ALT]).max()
+        hdg = np.abs(wrap(plan["heading_deg"] - tail[:, _HDG])).max()
+        ok = len(states) > hold_steps(dt) and alt <= cls.altitude_tolerance
+        ok = ok and hdg <= cls.heading_tolerance
+        return Verdict(bool(ok), f"over the last {HOLD_S:g} s: up to {alt:.0f} ft, {hdg:.1f} deg off")

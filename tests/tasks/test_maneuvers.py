@@ -1,0 +1,179 @@
+"""The maneuvers: each task's success rule on constructed trajectories (a pass and a near
+miss), what they observe, and their experts flying real episodes."""
+
+import math
+
+import numpy as np
+import pytest
+
+from gymfg_il.aircraft import c172p
+from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.evaluation.trace import trace_of
+from gymfg_il.rollout.agents import AgentSpec
+from gymfg_il.rollout.seeded import fly_many
+from gymfg_il.sim.properties import INDEX, NAMES
+from gymfg_il.tasks.courses import FT_PER_NM, ApproachTask, WaypointsTask
+from gymfg_il.tasks.geometry import offset_position
+from gymfg_il.tasks.maneuvers import ClimbTurnTask, TurnTask
+
+DT = 0.1
+LAT, LON = 37.6, -122.4
+
+
+def track(n, **columns):
+    """``n`` catalogue states; each keyword is a value or an array for that variable."""
+    s = np.zeros((n, len(NAMES)))
+    s[:, INDEX["altitude_agl_ft"]] = 5000.0
+    s[:, INDEX["airspeed_kts"]] = 100.0
+    s[:, INDEX["lat_deg"]], s[:, INDEX["lon_deg"]] = LAT, LON
+    for name, value in columns.items():
+        s[:, INDEX[name]] = value
+    return s
+
+
+def positions(north, east):
+    lat, lon = zip(*(offset_position(LAT, LON, n, e) for n, e in zip(north, east, strict=True)), strict=True)
+    return np.array(lat), np.array(lon)
+
+
+# -- turn ---------------------------------------------------------------------------------
+def turn_states(turn_deg, end_deg=None, alt_bump=0.0):
+    n = 900
+    turned = np.minimum(np.arange(n) * 0.5, abs(turn_deg)) * math.copysign(1, turn_deg)
+    if end_deg is not None:
+        turned[-200:] = end_deg
+    alt = np.full(n, 5000.0)
+    alt[300] += alt_bump
+    return track(n, heading_deg=(350.0 + turned) % 360.0, altitude_ft=alt)
+
+
+@pytest.mark.parametrize("turn", [-170.0, 75.0])
+def test_turn_passes_on_the_new_heading_either_way(turn):
+    plan = {"turn_deg": turn, "start_heading_deg": 350.0, "altitude_ft": 5000.0}
+    assert TurnTask.judge(plan, turn_states(turn), DT).success
+
+
+def test_turn_near_misses_fail():
+    plan = {"turn_deg": 120.0, "start_heading_deg": 350.0, "altitude_ft": 5000.0}
+    assert not TurnTask.judge(plan, turn_states(120.0, end_deg=114.0), DT).success  # 6 deg short
+    assert TurnTask.judge(plan, turn_states(120.0, end_deg=116.0), DT).success  # 4 deg short
+    bumped = TurnTask.judge(plan, turn_states(120.0, alt_bump=101.0), DT)
+    assert not bumped.success and "altitude" in bumped.detail
+    # the wrong way round ends on the same heading but has turned -240, not +120
+    assert not TurnTask.judge(plan, turn_states(-240.0), DT).success
+
+
+def test_turn_observes_the_turn_left_unwrapped_across_north():
+    task = TurnTask()
+    task.bind(c172p("x"), DT, 900)
+    rng = np.random.default_rng(3)
+    task.reset(track(1, heading_deg=350.0)[0], rng)
+    task.plan["turn_deg"] = 90.0  # fly 20 deg right across north over two steps
+    names = task.observation_names
+    obs = task.observe(track(1, heading_deg=5.0)[0], 1)
+    obs = task.observe(track(1, heading_deg=10.0)[0], 2)
+    assert obs[names.index("turn_remaining_deg")] == pytest.approx(70.0)
+    assert task.observe(track(1, heading_deg=10.0)[0], 2)[-3] == pytest.approx(70.0)  # once a step
+
+
+# -- climb and turn ------------------------------------------------------------------------
+def test_climb_turn_needs_both_targets_held():
+    plan = {"altitude_ft": 6000.0, "heading_deg": 40.0}
+    good = track(900, altitude_ft=np.linspace(5000, 6040, 900), heading_deg=42.0)
+    good[-100:, INDEX["altitude_ft"]] = 6040.0
+    assert ClimbTurnTask.judge(plan, good, DT).success
+    high = good.copy()
+    high[-100:, INDEX["altitude_ft"]] = 6055.0
+    assert not ClimbTurnTask.judge(plan, high, DT).success
+    off = good.copy()
+    off[-1, INDEX["heading_deg"]] = 43.5
+    assert not ClimbTurnTask.judge(plan, off, DT).success
+
+
+# -- waypoints -----------------------------------------------------------------------------
+GATES = [[5000.0, 0.0, 5000.0], [10000.0, 3000.0, 5200.0], [14000.0, 0.0, 5100.0]]
+PLAN = {"origin": [LAT, LON], "gates": GATES, "radius_ft": 300.0, "altitude_tolerance_ft": 150.0}
+
+
+def through(points, miss_last_by=0.0):
+    """A path through ``points`` (north, east, alt), 20 ft per step."""
+    path = [np.array([0.0, 0.0, 5000.0])]
+    for k, p in enumerate(points):
+        p = np.array(p, float)
+        if k == len(points) - 1:
+            p[1] += miss_last_by
+        a = path[-1]
+        steps = int(np.hypot(*(p - a)[:2]) / 20.0) + 1
+        path += [a + (p - a) * (i + 1) / steps for i in range(steps)]
+    path = np.array(path)
+    lat, lon = positions(path[:, 0], path[:, 1])
+    return track(len(path), lat_deg=lat, lon_deg=lon, altitude_ft=path[:, 2])
+
+
+def test_waypoints_pass_through_all_three_in_order():
+    assert WaypointsTask.judge(PLAN, through(GATES), DT).success
+    near = WaypointsTask.judge(PLAN, through(GATES, miss_last_by=320.0), DT)
+    assert not near.success and "gate 3" in near.detail
+    assert WaypointsTask.judge(PLAN, through(GATES, miss_last_by=280.0), DT).success
+    out_of_order = through([GATES[1], GATES[0], GATES[2]])
+    assert not WaypointsTask.judge(PLAN, out_of_order, DT).success
+    low = [GATES[0], [*GATES[1][:2], GATES[1][2] - 160.0], GATES[2]]
+    assert not WaypointsTask.judge(PLAN, through(low), DT).success
+
+
+# -- approach ------------------------------------------------------------------------------
+APPROACH = {
+    "threshold": [LAT, LON],
+    "course_deg": 0.0,
+    "threshold_ft": 3000.0,
+    "glide_deg": 3.0,
+    "approach_kts": 70.0,
+    "decision_height_ft": 200.0,
+    "hold_from_ft": 2.5 * FT_PER_NM,
+}
+
+
+def final(offset_ft=0.0, high_ft=0.0, speed=70.0, until_nm=0.6):
+    distance = np.linspace(3.5, until_nm, 1000) * FT_PER_NM
+    lat, lon = positions(-distance, np.full_like(distance, offset_ft))
+    alt = 3000.0 + np.maximum(200.0, distance * math.tan(math.radians(3.0))) - high_ft
+    alt[:100] -= 250.0  # below the path before capturing it
+    return track(len(distance), lat_deg=lat, lon_deg=lon, altitude_ft=alt, airspeed_kts=speed)
+
+
+def test_approach_holds_the_path_and_line_to_decision_height():
+    assert ApproachTask.judge(APPROACH, final(), DT).success
+    assert ApproachTask.judge(APPROACH, final(offset_ft=190.0), DT).success
+    wide = ApproachTask.judge(APPROACH, final(offset_ft=210.0), DT)
+    assert not wide.success and "centre line" in wide.detail
+    assert not ApproachTask.judge(APPROACH, final(high_ft=-110.0), DT).success
+    assert not ApproachTask.judge(APPROACH, final(speed=81.0), DT).success
+    short = ApproachTask.judge(APPROACH, final(until_nm=0.7), DT)
+    assert not short.success and "short" in short.detail
+
+
+def test_maneuvers_default_to_their_own_episode_time():
+    assert FlightSpec.solo("c172p", "approach").episode_time_s == 180.0
+    assert FlightSpec.solo("c172p", "waypoints").episode_time_s == 120.0
+    assert FlightSpec.solo("c172p", "turn").episode_time_s == 90.0
+    assert FlightSpec.solo("c172p", "approach", episode_time_s=30).episode_time_s == 30
+
+
+# -- the experts, flying -------------------------------------------------------------------
+@pytest.mark.parametrize("task", ["turn", "climb-turn", "waypoints", "approach"])
+def test_expert_flies_the_maneuver(task):
+    flight = FlightSpec.solo("c172p", task)
+    episodes = fly_many(flight, AgentSpec.controller(), [7001, 7002])
+    for ep in episodes:
+        trace = trace_of(ep)
+        assert trace.verdict and not trace.terminated, (ep.seed, trace.detail)
+
+
+def test_gates_left_as_observed_agrees_with_the_judge():
+    (ep,) = fly_many(FlightSpec.solo("c172p", "waypoints"), AgentSpec.controller(), [7003])
+    t = ep.solo
+    left = t.next_observations[:, list(t.start.task["observation"]).index("gates_left")]
+    passed_at = [int(np.flatnonzero(left <= 3 - k)[0]) for k in (1, 2, 3)]
+    states = np.vstack([t.start.state[None], t.states])
+    assert WaypointsTask.judge(t.start.task["plan"], states, ep.dt).success
+    assert passed_at == sorted(passed_at) and left[-1] == 0
