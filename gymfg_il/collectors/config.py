@@ -25,14 +25,15 @@ class CollectConfig:
     Attributes:
         kind: who flies: ``autopilot`` (the task's PID controller) or ``manual`` (a person).
         aircraft: JSBSim model (c172p, f15, A320, or any other JSBSim ships).
-        task: task family: altitude, roll, pitch, heading, airspeed, sideslip (the rudder's
-            task), level.
+        task: a target task (altitude, roll, pitch, heading, airspeed, sideslip: the rudder's
+            task, level) or a maneuver (turn, climb-turn, waypoints, formation, approach).
         dynamic: moving targets instead of fixed ones.
         episodes: episodes to record (manual: 0 = until you quit).
         episode_time_s: seconds per episode (default: the task's own: 90 for most, 120 for
             waypoints, 180 for approach).
         agent_hz: agent rate = the dataset's fps, a divisor of 120.
-        seed: seed of the first episode (episode i uses seed + i).
+        seed: seed of the first episode (episode i uses seed + i); from 1000, so that
+            `eval`, whose seeds start at 0, flies cases the demonstrations never showed.
         noise: autopilot only: DART-style noise: std of Gaussian noise added to the executed
             surfaces (the dataset keeps the demonstrator's clean action as the label), so the
             demonstrations show how to recover from small deviations; 0 = none. Without it,
@@ -65,7 +66,7 @@ class CollectConfig:
     episodes: int = 10
     episode_time_s: float | None = field(default=None, metadata={"flag": "--episode-time"})
     agent_hz: int = DEFAULT_AGENT_HZ
-    seed: int = 0
+    seed: int = 1000
     noise: float = 0.02
     turbulence: Literal["none", "light", "moderate", "severe"] = "none"
     wind_kt: float = 0.0

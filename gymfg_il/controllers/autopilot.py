@@ -274,6 +274,7 @@ MANEUVER_TARGETS: dict[str, Targets] = {
         lateral="track",
         lateral_source="course_error_deg",
         track_source="centerline_offset_ft",
+        track_gain=0.03,
         speed_source="airspeed_kts_error",
         relative=_BOTH | {"speed"},
     ),

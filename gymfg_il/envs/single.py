@@ -28,7 +28,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
     """One JSBSim aircraft flying one task, with the standard gymnasium API.
 
     Args:
-        task: a task family name (``altitude``, ``roll``, ``pitch``, ``heading``, ``airspeed``,
+        task: a task name (``altitude``, ``roll``, ``pitch``, ``heading``, ``airspeed``,
             ``level``, ``dummy``), a Task class, or a configured Task instance.
         aircraft: JSBSim model (``c172p``, ``f15``, ``A320``, any of
             ``gymfg_il.aircraft.available_models()``).

@@ -28,8 +28,9 @@ class EvalConfig:
         policy: a trained policy (checkpoint folder) to fly beside the controller;
             repeatable. A policy flies its own flight (aircraft, task and options, agent
             rate, episode time, from its config.json) unless a flag below changes it.
-        task: task family: altitude, roll, pitch, heading, airspeed, sideslip (the rudder's
-            task), level (default: the policy's, else altitude).
+        task: a target task (altitude, roll, pitch, heading, airspeed, sideslip: the rudder's
+            task, level) or a maneuver (turn, climb-turn, waypoints, formation, approach);
+            default: the policy's, else altitude.
         dynamic: moving targets (the family's dynamic task) instead of fixed ones (default:
             the policy's, else fixed).
         aircraft: JSBSim model: c172p, f15, A320 or any other JSBSim ships (default: the

@@ -59,14 +59,16 @@ class ChunkPolicy(NormalizedPolicy):
         else:
             history, chunks = state
             history = torch.cat([history[:, 1:], obs.unsqueeze(1)], dim=1)
-        chunks = [*chunks[-(cfg.chunk - 1) :], self.forward(history)] if cfg.chunk > 1 else [
-            self.forward(history)
-        ]
+        chunks = (
+            [*chunks[-(cfg.chunk - 1) :], self.forward(history)]
+            if cfg.chunk > 1
+            else [self.forward(history)]
+        )
         # chunk j (oldest first) was made len - 1 - j steps ago: its entry for now is that one
         n = len(chunks)
         preds = torch.stack([c[:, n - 1 - j] for j, c in enumerate(chunks)], dim=0)
         weights = torch.tensor(
-            [math.exp(-cfg.ensemble_decay * j) for j in range(n)], dtype=preds.dtype
+            [math.exp(-cfg.ensemble_decay * (n - 1 - j)) for j in range(n)], dtype=preds.dtype
         ).to(preds.device)
         action = (preds * weights[:, None, None]).sum(0) / weights.sum()
         return self.action_norm.inverse(action), (history, chunks)

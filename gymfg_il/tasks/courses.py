@@ -6,11 +6,13 @@ plan records that point as latitude and longitude, so a judge needs nothing but 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
 import numpy as np
 
+from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft, wrap
 from gymfg_il.tasks.rewards import closeness
@@ -29,7 +31,7 @@ class WaypointsTask(ManeuverTask):
     | entry | unit | meaning |
     | --- | --- | --- |
     | gate_distance_ft | ft | horizontal distance to the next gate (0 once all are passed) |
-    | gate_bearing_error_deg | deg | bearing of the next gate - heading (after the last: the last leg's course - heading) |
+    | gate_bearing_error_deg | deg | the next gate's bearing (last: the last leg's) - heading |
     | gate_altitude_error_ft | ft | the next gate's altitude - altitude |
     | next_turn_deg | deg | the turn at the next gate onto the leg after it (0 at the last) |
     | gates_left | 1 | gates still to pass (3, 2, 1, 0) |
@@ -140,15 +142,17 @@ class ApproachTask(ManeuverTask):
     | distance_ft | ft | distance to the threshold along the runway course (positive before it) |
     | centerline_offset_ft | ft | how far right of the extended centre line |
     | course_error_deg | deg | runway course - heading, wrapped |
-    | glidepath_error_ft | ft | the glide path's altitude here - altitude (the path levels at 200 ft above the threshold) |
+    | glidepath_error_ft | ft | the path's altitude here (level below 200 ft) - altitude |
     | airspeed_kts_error | kt | approach speed - airspeed |
+    | airspeed_kts_error_integral | kt·s | that error summed over the steps times dt (+/- 600) |
     | height_above_threshold_ft | ft | altitude - threshold elevation |
 
     Plan: a runway whose course is within 30 deg of the start heading, its threshold 3.5-4
     NM ahead along the course, the aircraft up to 1,500 ft either side of the centre line and
     0-300 ft below (or up to 100 ft above) the glide path; approach speed 1.4 x the
-    aircraft's stall speed (70 kt for the c172p). Reward: ``0.4 exp(-|glide path error| /
-    100) + 0.4 exp(-|offset| / 300) + 0.2 exp(-|speed error| / 10)`` minus the smoothness term.
+    aircraft's stall speed (70 kt for the c172p), the start 10-40 % faster.
+    Reward: ``0.4 exp(-|glide path error| / 100) + 0.4 exp(-|offset| / 300) + 0.2
+    exp(-|speed error| / 10)`` minus the smoothness term.
     Success: the aircraft reaches the decision height (200 ft above the threshold on the
     path), and from 2.5 NM out down to it stays within 100 ft of the glide path, 200 ft of
     the centre line and 10 kt of the approach speed.
@@ -163,6 +167,7 @@ class ApproachTask(ManeuverTask):
         "course_error_deg",
         "glidepath_error_ft",
         "airspeed_kts_error",
+        "airspeed_kts_error_integral",
         "height_above_threshold_ft",
     )
     tracked_entry = ("altitude_ft", "glidepath_error_ft", 100.0)
@@ -170,6 +175,18 @@ class ApproachTask(ManeuverTask):
     decision_height_ft = 200.0
     hold_from_nm = 2.5
     tolerances = {"glide path": 100.0, "centre line": 200.0, "airspeed": 10.0}  # noqa: RUF012
+
+    def approach_kts(self) -> float:
+        return round(1.4 * self._profile().min_airspeed_kts, 1)
+
+    def initial_conditions(self, rng: np.random.Generator) -> InitialConditions:
+        """Cruise altitude, any heading, 10-40 % above the approach speed (slowing from
+        cruise would take most of the final)."""
+        if self.start is not None:
+            return self.start
+        ic = super().initial_conditions(rng)
+        speed = self.approach_kts() * float(rng.uniform(1.1, 1.4))
+        return dataclasses.replace(ic, airspeed_kts=speed)
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
         course = (float(state[_HDG]) + float(rng.uniform(-30.0, 30.0))) % 360.0
@@ -188,7 +205,7 @@ class ApproachTask(ManeuverTask):
             "course_deg": course,
             "threshold_ft": float(state[_ALT]) - distance * tan - below,
             "glide_deg": self.glide_deg,
-            "approach_kts": round(1.4 * self._profile().min_airspeed_kts, 1),
+            "approach_kts": self.approach_kts(),
             "decision_height_ft": self.decision_height_ft,
             "hold_from_ft": self.hold_from_nm * FT_PER_NM,
         }
@@ -212,12 +229,19 @@ class ApproachTask(ManeuverTask):
     def extras(self, state: np.ndarray, step: int) -> list[float]:
         plan = self.plan
         g = self.geometry(plan, state)
+        speed_error = float(g["airspeed"])
+        # the throttle a memoryless policy cannot see: the speed loop's integral
+        if step == 0:
+            self._integral = 0.0
+        else:
+            self._integral = max(-600.0, min(600.0, self._integral + speed_error * self.dt))
         return [
             float(g["distance"]),
             float(g["offset"]),
             wrap(plan["course_deg"] - float(state[_HDG])),
             float(g["glidepath"]),
-            float(g["airspeed"]),
+            speed_error,
+            self._integral,
             float(state[_ALT]) - plan["threshold_ft"],
         ]
 

@@ -78,7 +78,7 @@ class ManeuverTask(Task):
         super().__init__(**kwargs)
         self.plan: dict[str, Any] = {}
         self._step = -1
-        self._extras = np.zeros(len(self.extra_names))
+        self._extras: np.ndarray = np.zeros(len(self.extra_names))
 
     def _extra_bounds(self) -> tuple[list[float], list[float]]:
         n = len(self.extra_names)
@@ -145,7 +145,7 @@ class TurnTask(ManeuverTask):
     | --- | --- | --- |
     | turn_remaining_deg | deg | the turn still to fly (positive: right), unwrapped |
     | altitude_ft_error | ft | start altitude - altitude |
-    | altitude_ft_error_integral | ft·s | that error summed over the steps times dt (at most +/- 60 s of 1,000 ft) |
+    | altitude_ft_error_integral | ft·s | that error summed over the steps times dt |
 
     Plan: the turn (magnitude drawn from [60, 180) deg, either way) and the start altitude.
     Reward: ``0.6 exp(-|remaining| / 30) + 0.4 exp(-|altitude error| / 100)`` minus the usual
@@ -191,7 +191,9 @@ class TurnTask(ManeuverTask):
             return Verdict(False, f"altitude off by {alt_err[worst]:.0f} ft at {worst * dt:.1f} s")
         tail = np.abs(plan["turn_deg"] - turned[-hold_steps(dt) :])
         if len(states) <= hold_steps(dt) or tail.max() > cls.heading_tolerance:
-            return Verdict(False, f"heading off the new one by up to {tail.max():.1f} deg at the end")
+            return Verdict(
+                False, f"heading off the new one by up to {tail.max():.1f} deg at the end"
+            )
         return Verdict(True, f"turned {turned[-1]:+.0f} of {plan['turn_deg']:+.0f} deg")
 
 
@@ -251,4 +253,6 @@ class ClimbTurnTask(ManeuverTask):
         hdg = np.abs(wrap(plan["heading_deg"] - tail[:, _HDG])).max()
         ok = len(states) > hold_steps(dt) and alt <= cls.altitude_tolerance
         ok = ok and hdg <= cls.heading_tolerance
-        return Verdict(bool(ok), f"over the last {HOLD_S:g} s: up to {alt:.0f} ft, {hdg:.1f} deg off")
+        return Verdict(
+            bool(ok), f"over the last {HOLD_S:g} s: up to {alt:.0f} ft, {hdg:.1f} deg off"
+        )

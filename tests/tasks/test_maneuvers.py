@@ -32,7 +32,9 @@ def track(n, **columns):
 
 
 def positions(north, east):
-    lat, lon = zip(*(offset_position(LAT, LON, n, e) for n, e in zip(north, east, strict=True)), strict=True)
+    lat, lon = zip(
+        *(offset_position(LAT, LON, n, e) for n, e in zip(north, east, strict=True)), strict=True
+    )
     return np.array(lat), np.array(lon)
 
 

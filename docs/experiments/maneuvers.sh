@@ -1,0 +1,31 @@
+#!/bin/bash
+# The maneuvers table of the README ("Maneuvers"): for each maneuver, 50 expert demonstrations
+# (default flags) -> an MLP and a chunking policy -> eval beside the expert on held-out seeds;
+# then 50 synthetic-pilot keyboard demonstrations of turn and waypoints -> an MLP -> eval
+# beside the pilot. About 40 minutes on two cores.
+# Usage: bash docs/experiments/maneuvers.sh [OUT] [EVAL_SEED] [AIRCRAFT]
+set -euo pipefail
+export HF_HUB_OFFLINE=1 SDL_VIDEODRIVER=dummy
+OUT=${1:-runs/experiments/maneuvers}
+EVAL_SEED=${2:-9000}
+AIRCRAFT=${3:-c172p}
+for TASK in turn climb-turn waypoints formation approach; do
+  D="$OUT/$TASK-$AIRCRAFT"
+  [ -d "$D/dataset" ] || python -m gymfg_il.collect autopilot --task "$TASK" --aircraft "$AIRCRAFT" \
+    --episodes 50 --seed 1000 --out "$D" --no-progress
+  for POLICY in mlp chunk; do
+    [ -f "$D-$POLICY/config.json" ] || python -m gymfg_il.train bc --dataset "$D/dataset" \
+      --policy "$POLICY" --out "$D-$POLICY" --no-progress
+  done
+  python -m gymfg_il.eval --policy "$D-mlp" --policy "$D-chunk" --episodes 16 \
+    --seed "$EVAL_SEED" --plots "$OUT/plots" --json "$D.eval.json" --no-progress
+done
+for TASK in turn waypoints; do
+  D="$OUT/pilot-$TASK-$AIRCRAFT"
+  [ -d "$D/dataset" ] || python -m gymfg_il.collect manual --pilot synthetic --device keyboard \
+    --task "$TASK" --aircraft "$AIRCRAFT" --episodes 50 --seed 2000 --out "$D" --no-progress
+  [ -f "$D-mlp/config.json" ] || python -m gymfg_il.train bc --dataset "$D/dataset" \
+    --out "$D-mlp" --no-progress
+  python -m gymfg_il.eval --policy "$D-mlp" --pilot synthetic --device keyboard --episodes 16 \
+    --seed "$EVAL_SEED" --json "$D.eval.json" --no-progress
+done
