@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from gymfg_il.learning.bc import DEFAULT_DATASET, TrainConfig
+from gymfg_il.learning.bc import DEFAULT_DATASET, EPOCHS_AUTOPILOT
 
 RECIPE = Path("collectors/sample.toml")
 
@@ -38,7 +38,7 @@ class DemoConfig:
     """
 
     dataset: Path = DEFAULT_DATASET
-    epochs: int = TrainConfig.epochs
+    epochs: int = EPOCHS_AUTOPILOT
     episodes: int = 10
     workers: int = 2
     runs: Path = Path("runs")

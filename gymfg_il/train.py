@@ -34,17 +34,20 @@ def main(argv: list[str] | None = None) -> int:
 def _bc(cfg: object, show_progress: bool) -> int:
     from gymfg_il import cli
     from gymfg_il.datasets.lerobot_api import hub_offline
-    from gymfg_il.learning.bc import TrainConfig, train_bc
+    from gymfg_il.learning.bc import TrainConfig, default_epochs, train_bc
+    from gymfg_il.learning.data import load_frames
 
     assert isinstance(cfg, TrainConfig)
     hub_offline()
-    bar = cli.progress_bar(cfg.epochs, "epochs", "ep", show_progress)
+    frames = load_frames(cfg.dataset)
+    epochs = cfg.epochs or default_epochs(frames)
+    bar = cli.progress_bar(epochs, "epochs", "ep", show_progress)
 
     def on_epoch(epoch: int, train: float, val: float) -> None:
         bar.update(1)
         bar.set_postfix(loss=f"{train:.4f}", val=f"{val:.4f}")
 
-    result = train_bc(cfg, on_epoch)
+    result = train_bc(cfg, on_epoch, frames)
     bar.close()
     print(
         f"trained {result.meta['name']} on {result.meta['train']['frames']} frames "

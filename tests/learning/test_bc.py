@@ -124,3 +124,15 @@ def test_policy_refuses_the_wrong_task(trained):
         agent.check_observation(AircraftEnv("heading", "c172p").observation_names)
     with pytest.raises(ConfigError, match="not a policy checkpoint"):
         PolicyAgent.load(trained.out.parent / "nothing-here")
+
+
+def test_default_epochs_follow_who_demonstrated(tiny_dataset):
+    from gymfg_il.learning.bc import EPOCHS_AUTOPILOT, EPOCHS_PERSON, default_epochs
+
+    frames = load_frames(tiny_dataset)
+    assert default_epochs(frames) == EPOCHS_AUTOPILOT == 60
+    for person in ("synthetic", "human", "policy+human"):
+        sources = list(frames.episodes["gymfg/source"])
+        sources[2] = person
+        frames.episodes = {**frames.episodes, "gymfg/source": sources}
+        assert default_epochs(frames) == EPOCHS_PERSON == 20

@@ -162,7 +162,7 @@ def test_maneuvers_default_to_their_own_episode_time():
 
 
 # -- the experts, flying -------------------------------------------------------------------
-@pytest.mark.parametrize("task", ["turn", "climb-turn", "waypoints", "approach"])
+@pytest.mark.parametrize("task", ["turn", "climb-turn", "waypoints", "formation", "approach"])
 def test_expert_flies_the_maneuver(task):
     flight = FlightSpec.solo("c172p", task)
     episodes = fly_many(flight, AgentSpec.controller(), [7001, 7002])
@@ -179,3 +179,52 @@ def test_gates_left_as_observed_agrees_with_the_judge():
     states = np.vstack([t.start.state[None], t.states])
     assert WaypointsTask.judge(t.start.task["plan"], states, ep.dt).success
     assert passed_at == sorted(passed_at) and left[-1] == 0
+
+
+# -- formation -----------------------------------------------------------------------------
+def formation(behind=150.0, right=100.0, late_error=0.0, steps=900):
+    """A lead flying north at 170 ft/s and a follower ``behind``/``right`` of it; from 60 s on
+    the follower drifts ``late_error`` ft further right."""
+    from gymfg_il.tasks.formation import FormationTask
+
+    north = np.arange(steps) * 17.0
+    lat, lon = positions(north, np.zeros(steps))
+    lead = [[la, lo, 5000.0, 0.0, 2.0, 0.0] for la, lo in zip(lat, lon, strict=True)]
+    east = np.full(steps, right)
+    east[600:] += late_error
+    flat, flon = positions(north - behind, east)
+    states = track(steps, lat_deg=flat, lon_deg=flon, altitude_ft=5000.0, heading_deg=0.0)
+    return FormationTask, {"slot_ft": [150.0, 100.0], "lead": lead}, states
+
+
+def test_formation_holds_the_slot_and_keeps_clear_of_the_lead():
+    task, plan, states = formation()
+    assert task.judge(plan, states, DT).success
+    task, plan, states = formation(late_error=95.0)
+    assert task.judge(plan, states, DT).success
+    task, plan, states = formation(late_error=105.0)
+    drift = task.judge(plan, states, DT)
+    assert not drift.success and "from the slot at 60.0 s" in drift.detail
+    task, plan, states = formation(behind=30.0, right=20.0)
+    close = task.judge(plan, states, DT)
+    assert not close.success and "within" in close.detail
+
+
+def test_formation_observes_the_slot_from_the_leads_pose_alone():
+    from gymfg_il.tasks.formation import FormationTask
+
+    task = FormationTask()
+    task.bind(c172p("x"), DT, 300)
+    task.reset(track(1, heading_deg=90.0, altitude_ft=5000.0)[0], np.random.default_rng(4))
+    lead = np.asarray(task.plan["lead"])
+    assert lead.shape == (301, 6)  # the lead flew the whole episode at reset
+    names = task.observation_names
+    obs = task.observe(track(1, heading_deg=90.0, altitude_ft=5000.0)[0], 0)
+    g = task.geometry(task.plan, track(1, heading_deg=90.0)[:1], np.array([0]))
+    assert obs[names.index("behind_slot_ft")] == pytest.approx(g["behind"][0], abs=0.01)
+    assert 100.0 <= obs[names.index("behind_slot_ft")] <= 300.0  # starts behind the slot
+    # the same seed flies the same lead
+    again = FormationTask()
+    again.bind(c172p("x"), DT, 300)
+    again.reset(track(1, heading_deg=90.0, altitude_ft=5000.0)[0], np.random.default_rng(4))
+    assert again.plan["lead"] == task.plan["lead"]
