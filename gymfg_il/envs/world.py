@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.aircraft import Aircraft
+from gymfg_il.controllers.lead import LeadPilot
 from gymfg_il.envs.actions import Controls
 from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.display import Displays
@@ -139,6 +140,8 @@ class World:
             for aircraft, spec in team.roster:
                 task = build_task(spec, f"team {team.name!r}, aircraft {aircraft.callsign!r}")
                 task.bind(aircraft, self.dt, self.max_steps)
+                if getattr(task, "needs_lead_pilot", False) and task.lead_pilot is None:  # type: ignore[attr-defined]
+                    task.lead_pilot = LeadPilot(aircraft.model, self.dt, config.sim_hz)  # type: ignore[attr-defined]
                 sim = self.pool.take(aircraft.model)
                 self.slots.append(Slot(len(self.slots), team.name, aircraft, task, sim))
         self.by_callsign = {s.callsign: s for s in self.slots}

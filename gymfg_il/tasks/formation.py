@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX, indices
-from gymfg_il.tasks.base import FLIGHT_VARS
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.maneuvers import FT_PER_DEG, ManeuverTask, Verdict, wrap
 from gymfg_il.tasks.rewards import closeness
@@ -26,7 +26,6 @@ LEAD_VIEW = ("lat_deg", "lon_deg", "altitude_ft", "roll_deg", "pitch_deg", "head
 _LEAD_IDX = indices(LEAD_VIEW)
 _ALT, _HDG = INDEX["altitude_ft"], INDEX["heading_deg"]
 _LAT, _LON = INDEX["lat_deg"], INDEX["lon_deg"]
-_LEAD_OBS = (*FLIGHT_VARS, "heading_deg", "altitude_ft_target", "heading_deg_target")
 
 
 def _lead_schedule(
@@ -86,6 +85,8 @@ class FormationTask(ManeuverTask):
         "lead_pitch_deg",
     )
     tracked_entry = ("altitude_ft", "below_slot_ft", 100.0)
+    needs_lead_pilot = True  # the environment sets ``lead_pilot`` (controllers.lead)
+    lead_pilot: Any = None
     join_s = 30.0
     tolerance_ft = 100.0
     min_separation_ft = 50.0
@@ -110,33 +111,14 @@ class FormationTask(ManeuverTask):
         self, ic: InitialConditions, alt_t: np.ndarray, hdg_t: np.ndarray, speed: float
     ) -> np.ndarray:
         """The lead's (lat, lon, altitude, roll, pitch, heading) at every step."""
-        from gymfg_il.controllers.autopilot import Autopilot, Targets
-        from gymfg_il.sim.simulation import Simulation
-
-        assert self.aircraft is not None
-        model, hz = self.aircraft.model, round(1.0 / self.dt)
-        sim = getattr(self, "_lead_sim", None)
-        if sim is None or sim.model != model or sim.agent_hz != hz:
-            self._lead_sim = sim = Simulation(model, agent_hz=hz)
-        targets = Targets(
-            vertical_source="altitude_ft_target",
-            lateral="heading",
-            lateral_source="heading_deg_target",
-            speed_source=speed,
-        )
-        pilot = Autopilot(_LEAD_OBS, model, self.dt, targets)
+        if self.lead_pilot is None:
+            raise ConfigError(
+                "the formation task's lead is flown by an autopilot the environment provides: "
+                "fly it in an env (AircraftEnv, OfflineEnv), or set task.lead_pilot = "
+                "gymfg_il.controllers.lead.LeadPilot(model, dt)"
+            )
         throttle = self._profile().cruise_throttle
-        pilot.set_throttle_trim(throttle)
-        state = sim.reset(ic, throttle)
-        own = indices((*FLIGHT_VARS, "heading_deg"))
-        track = np.empty((len(alt_t), len(LEAD_VIEW)))
-        for i in range(len(alt_t)):
-            track[i] = state[_LEAD_IDX]
-            if i + 1 < len(alt_t):
-                obs = np.append(state[own], (alt_t[i], hdg_t[i]))
-                sim.apply(*np.clip(pilot.act(obs), [-1, -1, -1, 0], [1, 1, 1, 1]))
-                state = sim.read()
-        return track
+        return np.asarray(self.lead_pilot(ic, alt_t, hdg_t, speed, throttle, _LEAD_IDX))
 
     @classmethod
     def geometry(

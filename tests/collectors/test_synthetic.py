@@ -67,7 +67,7 @@ def test_collect_manual_with_the_synthetic_pilot_runs_headless(tmp_path, capsys)
     assert "saved 2 episode(s)" in out and "2/2" in err  # the progress bar reached the end
     frames = load_frames(tmp_path / "dataset")
     assert frames.episodes["gymfg/source"] == ["synthetic"] * 2 and len(frames) == 300
-    assert frames.episodes["gymfg/seed"] == [0, 1]
+    assert frames.episodes["gymfg/seed"] == [1000, 1001]  # collect starts at 1000
 
 
 def test_eval_scores_the_synthetic_pilot_beside_the_controller(tmp_path):

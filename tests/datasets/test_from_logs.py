@@ -57,7 +57,7 @@ def test_dataset_opens_with_stock_lerobot_and_equals_the_log(built):
             assert bool(frame["next.done"]) == (i == 149)
             assert frame["task"].startswith("Climb or descend")
         meta = ds.meta.episodes[k]
-        assert meta["gymfg/seed"] == k and meta["gymfg/source"] == "autopilot"
+        assert meta["gymfg/seed"] == 1000 + k and meta["gymfg/source"] == "autopilot"
         assert meta["gymfg/aircraft"] == "c172p" and meta["gymfg/interventions"] == 0
         assert meta["gymfg/target"] == pytest.approx(ep.start_of("ego")["target"])
 

@@ -27,7 +27,7 @@ def test_log_holds_every_step_with_its_session(session):
     ep = log.complete_episodes[0]
     steps = ep.steps["ego"]
     assert len(steps) == 200 and steps.state.shape == (200, len(NAMES))
-    assert ep.start["seed"] == 0 and ep.end["outcome"] == "time limit"
+    assert ep.start["seed"] == 1000 and ep.end["outcome"] == "time limit"  # collect starts at 1000
     assert steps.observation.shape[1] == len(log.aircraft("ego")["observation_names"])
     # DART noise: executed actions differ from the clean labels, throttle untouched
     assert not np.array_equal(steps.action[:, :3], steps.label[:, :3])

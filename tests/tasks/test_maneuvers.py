@@ -211,10 +211,15 @@ def test_formation_holds_the_slot_and_keeps_clear_of_the_lead():
 
 
 def test_formation_observes_the_slot_from_the_leads_pose_alone():
+    from gymfg_il.controllers.lead import LeadPilot
+    from gymfg_il.errors import ConfigError
     from gymfg_il.tasks.formation import FormationTask
 
     task = FormationTask()
     task.bind(c172p("x"), DT, 300)
+    with pytest.raises(ConfigError, match="lead_pilot"):  # the env gives it one
+        task.reset(track(1, heading_deg=90.0, altitude_ft=5000.0)[0], np.random.default_rng(4))
+    task.lead_pilot = LeadPilot("c172p", DT)
     task.reset(track(1, heading_deg=90.0, altitude_ft=5000.0)[0], np.random.default_rng(4))
     lead = np.asarray(task.plan["lead"])
     assert lead.shape == (301, 6)  # the lead flew the whole episode at reset
@@ -226,5 +231,6 @@ def test_formation_observes_the_slot_from_the_leads_pose_alone():
     # the same seed flies the same lead
     again = FormationTask()
     again.bind(c172p("x"), DT, 300)
+    again.lead_pilot = LeadPilot("c172p", DT)
     again.reset(track(1, heading_deg=90.0, altitude_ft=5000.0)[0], np.random.default_rng(4))
     assert again.plan["lead"] == task.plan["lead"]
