@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from gymfg_il.evaluation.trace import Trace
 from gymfg_il.sim.properties import ACTION_NAMES
@@ -61,6 +62,13 @@ def figure1(episodes: Sequence[Trace], control: int, title: str, path: Path) -> 
     axes[0][2].set_title("reward")
     for ax in axes[-1]:
         ax.set_xlabel("time (s)")
+    return save_figure(fig, title, path)
+
+
+def save_figure(fig: Any, title: str, path: Path) -> Path:
+    """Title, lay out and write ``fig`` to ``path`` (PNG), then free it."""
+    import matplotlib.pyplot as plt
+
     fig.suptitle(title)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -10,9 +10,10 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.evaluation.plots import save_figure
 from gymfg_il.evaluation.trace import Trace
 from gymfg_il.sim.properties import INDEX
-from gymfg_il.tasks.maneuvers import local_ft
+from gymfg_il.tasks.maneuvers import FT_PER_DEG, local_ft, wrap
 
 COLOURS = ("black", "tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown")
 
@@ -28,8 +29,14 @@ def _origin(plan: Mapping[str, Any]) -> tuple[float, float]:
     return float(point[0]), float(point[1])
 
 
-def _draw_plan(top: Any, side: Any, plan: Mapping[str, Any]) -> None:
+def _draw_plan(top: Any, side: Any, plan: Mapping[str, Any], origin: tuple[float, float]) -> None:
     import matplotlib.patches as mpatches
+
+    if "lead" in plan:  # the lead's track (lat, lon, altitude, roll, pitch, heading per step)
+        lead = np.asarray(plan["lead"])
+        north = (lead[:, 0] - origin[0]) * FT_PER_DEG
+        east = wrap(lead[:, 1] - origin[1]) * FT_PER_DEG * math.cos(math.radians(origin[0]))
+        top.plot(east, north, color="tab:red", ls="--", lw=1, label="lead")
 
     if "gates" in plan:
         for k, (north, east, _) in enumerate(plan["gates"]):
@@ -81,7 +88,7 @@ def ground_tracks(
                 side.plot(np.arange(len(alt)) * tr.dt, alt, color=colour, lw=1)
         if not approach:  # the altitude each step aimed for (the next gate's, ...)
             side.plot(first.time_s, first.target, color="tab:red", ls="--", lw=1, label="target")
-        _draw_plan(top, side, plan)
+        _draw_plan(top, side, plan, origin)
         top.set_aspect("equal", adjustable="datalim")
         top.set_ylabel(f"seed {first.seed}\nnorth (ft)")
         top.legend(fontsize=7, loc="best")
@@ -90,9 +97,4 @@ def ground_tracks(
     axes[-1][0].set_xlabel("east (ft)")
     axes[0][0].set_title("ground track")
     axes[0][1].set_title("vertical profile")
-    fig.suptitle(title)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return save_figure(fig, title, path)
