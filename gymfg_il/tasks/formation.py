@@ -104,8 +104,9 @@ class FormationTask(ManeuverTask):
         speed = 0.95 * profile.cruise_kts
         ic = InitialConditions(lat, lon, float(state[_ALT]) - up, heading, speed)
         alt_t, hdg_t = _lead_schedule(rng, self.max_steps, self.dt, ic.altitude_ft, heading)
-        track = self._fly_lead(ic, alt_t, hdg_t, speed)
-        return {"slot_ft": list(self.slot), "lead": np.round(track, 8).tolist()}
+        track = np.round(self._fly_lead(ic, alt_t, hdg_t, speed), 8)
+        self._lead = track  # as an array, for every step's observation
+        return {"slot_ft": list(self.slot), "lead": track.tolist()}
 
     def _fly_lead(
         self, ic: InitialConditions, alt_t: np.ndarray, hdg_t: np.ndarray, speed: float
@@ -122,10 +123,16 @@ class FormationTask(ManeuverTask):
 
     @classmethod
     def geometry(
-        cls, plan: dict[str, Any], states: np.ndarray, steps: np.ndarray
+        cls,
+        plan: dict[str, Any],
+        states: np.ndarray,
+        steps: np.ndarray,
+        track: np.ndarray | None = None,
     ) -> dict[str, np.ndarray]:
-        """Where ``states`` (rows, at agent ``steps``) are from the slot and the lead."""
-        lead = np.asarray(plan["lead"])[np.minimum(steps, len(plan["lead"]) - 1)]
+        """Where ``states`` (rows, at agent ``steps``) are from the slot and the lead
+        (``track``: the plan's lead as an array, when the caller has it)."""
+        track = np.asarray(plan["lead"]) if track is None else track
+        lead = track[np.minimum(steps, len(track) - 1)]
         cos_lat = math.cos(math.radians(float(lead[0, 0])))
         north = (states[:, _LAT] - lead[:, 0]) * FT_PER_DEG
         east = wrap(states[:, _LON] - lead[:, 1]) * FT_PER_DEG * cos_lat
@@ -142,7 +149,7 @@ class FormationTask(ManeuverTask):
         }
 
     def extras(self, state: np.ndarray, step: int) -> list[float]:
-        g = self.geometry(self.plan, state[None], np.array([step]))
+        g = self.geometry(self.plan, state[None], np.array([step]), self._lead)
         behind = float(g["behind"][0])
         if step == 0:
             self._last_behind = behind
