@@ -21,7 +21,10 @@ from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 from gymfg_il.sim.weather import Turbulence, Weather
 from gymfg_il.tasks.base import Task
+from gymfg_il.tasks.scenery import landmarks_of
 from gymfg_il.tasks.targets import TargetTask
+from gymfg_il.viz.camera import Camera
+from gymfg_il.viz.window import FrameWindow
 
 
 class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
@@ -42,6 +45,12 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
             attached the env runs at real time.
         turbulence, wind_kt, wind_from_deg: the weather (``sim.weather``): JSBSim's
             turbulence (none, light, moderate, severe) and a steady wind, seeded per episode.
+        render_mode: ``None``, ``"rgb_array"`` (``render()`` returns the camera's frame,
+            (height, width, 3) uint8) or ``"human"`` (a window shows it at every reset and
+            step, paced to real time at ``metadata["render_fps"]`` = ``agent_hz``).
+        camera: the view ``render()`` draws (``viz.camera``: ``front``, the pilot's eye, or
+            ``chase``), with the task's landmarks (runway, gates, lead).
+        render_size: (width, height) of rendered frames.
 
     Observation: the task's observation (float32, names in ``env.observation_names``; see the
     task's docstring for the table with units). Action: ``Box([-1, -1, -1, 0], [1, 1, 1, 1])`` =
@@ -58,7 +67,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
     builds the env a spec describes.
     """
 
-    metadata = {"render_modes": []}  # noqa: RUF012
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": DEFAULT_AGENT_HZ}  # noqa: RUF012
 
     def __init__(
         self,
@@ -75,9 +84,13 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         turbulence: Turbulence = "none",
         wind_kt: float = 0.0,
         wind_from_deg: float | None = None,
+        camera: str = "front",
+        render_size: tuple[int, int] = (128, 128),
     ) -> None:
-        if render_mode is not None:
-            raise ConfigError(f"render_mode={render_mode!r} is not supported; use None")
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ConfigError(
+                f"render_mode={render_mode!r} is not supported; use None, 'rgb_array' or 'human'"
+            )
         kwargs = dict(task_kwargs or {})
         flight: FlightSpec | None = None
         if isinstance(task, str):
@@ -124,11 +137,16 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         self.action_space = gym.spaces.Box(ACTION_LOW, ACTION_HIGH, dtype=np.float32)
         self.observation_names = self.task.observation_names
         self.render_mode = render_mode
+        self.metadata = {**type(self).metadata, "render_fps": agent_hz}
+        self.camera = Camera(*render_size, view=camera)
+        self._window: FrameWindow | None = None
         self._done = True
 
     @classmethod
-    def from_flight(cls, flight: FlightSpec, views: Sequence[int] | None = None) -> AircraftEnv:
-        """The env of a solo flight spec."""
+    def from_flight(
+        cls, flight: FlightSpec, views: Sequence[int] | None = None, **kwargs: Any
+    ) -> AircraftEnv:
+        """The env of a solo flight spec (``kwargs``: render_mode, camera, render_size)."""
         ego = flight.solo_aircraft
         return cls(
             ego.task,
@@ -142,6 +160,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
             turbulence=flight.turbulence,
             wind_kt=flight.wind_kt,
             wind_from_deg=flight.wind_from_deg,
+            **kwargs,
         )
 
     @property
@@ -176,6 +195,8 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         self._done = False
         slot = self._slot
         info = {"target": task.target_value(0), "start": slot.state.copy()}
+        if self.render_mode == "human":
+            self.render()
         return task.observe(slot.state, 0), info
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
@@ -189,9 +210,30 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         truncated = world.steps >= world.max_steps and not terminated
         self._done = terminated or truncated
         info = {"reason": slot.reason} if terminated else {}
+        if self.render_mode == "human":
+            self.render()
         return slot.task.observe(slot.state, world.steps), slot.reward, terminated, truncated, info
 
+    def render(self) -> np.ndarray | None:
+        """The camera's frame of the current state (``rgb_array``), or show it (``human``)."""
+        if self.render_mode is None:
+            gym.logger.warn("render() needs a render_mode (rgb_array or human) at make()")
+            return None
+        task = self.task
+        frame = self.camera.frame(
+            self._slot.state, landmarks_of(task, getattr(task, "plan", None), self.world.steps)
+        )
+        if self.render_mode == "rgb_array":
+            return frame
+        if self._window is None:
+            self._window = FrameWindow(fps=self.metadata["render_fps"], title=f"GymFG {task.name}")
+        self._window.show(frame)
+        return None
+
     def close(self) -> None:
+        if self._window is not None:
+            self._window.close()
+            self._window = None
         if self.world.slots:
             self.world.close()
             self.world.pool.close()

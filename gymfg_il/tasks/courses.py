@@ -14,8 +14,10 @@ import numpy as np
 
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
+from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft, wrap
 from gymfg_il.tasks.rewards import closeness
+from gymfg_il.tasks.scenery import Landmark
 
 _ALT, _HDG, _VC = INDEX["altitude_ft"], INDEX["heading_deg"], INDEX["airspeed_kts"]
 _LAT, _LON = INDEX["lat_deg"], INDEX["lon_deg"]
@@ -116,6 +118,19 @@ class WaypointsTask(ManeuverTask):
         )
 
     @classmethod
+    def landmarks(cls, plan: dict[str, Any], step: int) -> list[Landmark]:
+        """The three gates, each facing the leg that leads to it, as wide and tall as what
+        counts as inside (``tasks.scenery``)."""
+        found, previous = [], (0.0, 0.0)
+        for north, east, alt in plan["gates"]:
+            facing = math.degrees(math.atan2(east - previous[1], north - previous[0]))
+            lat, lon = offset_position(plan["origin"][0], plan["origin"][1], north, east)
+            width, height = 2.0 * plan["radius_ft"], 2.0 * plan["altitude_tolerance_ft"]
+            found.append(Landmark("gate", lat, lon, alt, facing, width_ft=width, length_ft=height))
+            previous = (north, east)
+        return found
+
+    @classmethod
     def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
         north, east = local_ft(states, plan["origin"])
         alt = states[:, _ALT]
@@ -195,8 +210,6 @@ class ApproachTask(ManeuverTask):
         c, s = math.cos(math.radians(course)), math.sin(math.radians(course))
         north, east = distance * c + offset * s, distance * s - offset * c
         lat0, lon0 = float(state[_LAT]), float(state[_LON])
-        from gymfg_il.tasks.geometry import offset_position
-
         lat, lon = offset_position(lat0, lon0, north, east)
         tan = math.tan(math.radians(self.glide_deg))
         below = float(rng.uniform(-100.0, 300.0))
@@ -251,6 +264,13 @@ class ApproachTask(ManeuverTask):
             + 0.4 * closeness(extras[1], 300.0)
             + 0.2 * closeness(extras[4], 10.0)
         )
+
+    @classmethod
+    def landmarks(cls, plan: dict[str, Any], step: int) -> list[Landmark]:
+        """The runway: 150 ft wide, 5,000 ft long from the threshold along the course."""
+        lat, lon = plan["threshold"]
+        course, alt = plan["course_deg"], plan["threshold_ft"]
+        return [Landmark("runway", lat, lon, alt, course, width_ft=150.0, length_ft=5000.0)]
 
     @classmethod
     def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:

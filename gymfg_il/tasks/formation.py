@@ -21,6 +21,7 @@ from gymfg_il.sim.properties import INDEX, indices
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.maneuvers import FT_PER_DEG, ManeuverTask, Verdict, wrap
 from gymfg_il.tasks.rewards import closeness
+from gymfg_il.tasks.scenery import Landmark
 
 LEAD_VIEW = ("lat_deg", "lon_deg", "altitude_ft", "roll_deg", "pitch_deg", "heading_deg")
 _LEAD_IDX = indices(LEAD_VIEW)
@@ -167,6 +168,13 @@ class FormationTask(ManeuverTask):
 
     def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
         return closeness(math.sqrt(extras[0] ** 2 + extras[2] ** 2 + extras[3] ** 2), 100.0)
+
+    @classmethod
+    def landmarks(cls, plan: dict[str, Any], step: int) -> list[Landmark]:
+        """The lead, where its track has it at agent ``step``."""
+        track = plan["lead"]
+        lat, lon, alt, roll, pitch, heading = track[min(step, len(track) - 1)]
+        return [Landmark("aircraft", lat, lon, alt, heading, roll, pitch)]
 
     @classmethod
     def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:

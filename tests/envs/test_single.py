@@ -11,8 +11,12 @@ from gymfg_il.sim.initial import InitialConditions
 
 @pytest.mark.parametrize("env_id", sorted(IDS))
 def test_check_env_passes_for_every_registered_id(env_id):
-    env = gym.make(env_id, disable_env_checker=True)
-    check_env(env.unwrapped, skip_render_check=True)
+    env = gym.make(env_id, disable_env_checker=True, render_mode="rgb_array")
+    check_env(env.unwrapped, skip_render_check=False)
+    env.reset(seed=1)
+    frame = env.render()
+    assert frame.shape == (128, 128, 3) and frame.dtype == np.uint8
+    assert env.metadata["render_fps"] == 10
     env.close()
 
 
@@ -87,4 +91,4 @@ def test_bad_env_arguments():
     with pytest.raises(UnknownAircraftError):
         AircraftEnv("altitude", aircraft="cessna")
     with pytest.raises(ConfigError, match="render_mode"):
-        AircraftEnv(render_mode="human")
+        AircraftEnv(render_mode="ansi")
