@@ -77,6 +77,39 @@ def dataset_build(episodes: int) -> Row:
     )
 
 
+def dataset_build_with_images(episodes: int) -> Row:
+    """frames/s of ``build_from_logs`` with the front camera: every frame drawn from the
+    logged state and encoded to LeRobot video (H.264), beside the same build without it."""
+    os.environ["HF_HUB_OFFLINE"] = "1"
+    from gymfg_il.collectors.autopilot import record_autopilot
+    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.datasets import lerobot_api as lr
+    from gymfg_il.datasets.from_logs import build_from_logs
+
+    lr.load()
+    tmp = Path(tempfile.mkdtemp(prefix="gymfg-bench-"))
+    try:
+        cfg = CollectConfig(episodes=episodes, out=tmp / "session", images=["front"])
+        result = record_autopilot(cfg)
+        plain = build_from_logs([result.log], tmp / "plain", images=[])
+        with_images = build_from_logs([result.log], tmp / "images")
+        size = sum(f.stat().st_size for f in (tmp / "images/videos").rglob("*.mp4"))
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    rate = with_images.frames / with_images.seconds
+    return Row(
+        "dataset_build_with_images_frames_per_s",
+        rate,
+        "frames/s",
+        1000,
+        detail=[
+            f"state only (same logs)         {plain.frames / plain.seconds:9,.0f} frames/s",
+            f"with the front camera, 128x128 {rate:9,.0f} frames/s "
+            f"(video {size / with_images.frames / 1024:.1f} KiB/frame)",
+        ],
+    )
+
+
 def train_pipeline(dataset: Path, stock_items: int) -> Row:
     """frames/s delivered to the model: our in-memory tensor batches beside stock
     ``LeRobotDataset`` + ``torch.utils.data.DataLoader`` (per-item ``__getitem__``)."""
@@ -118,5 +151,6 @@ def train_pipeline(dataset: Path, stock_items: int) -> Row:
 def rows(quick: bool) -> list[Row]:
     return [
         dataset_build(5 if quick else 20),
+        dataset_build_with_images(3 if quick else 10),
         train_pipeline(SAMPLE, 1000 if quick else 4000),
     ]

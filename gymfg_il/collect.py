@@ -20,8 +20,12 @@ from pathlib import Path
 
 EPILOG = __doc__.split("\n\n", 1)[1]
 FLIGHT = ("aircraft", "task", "dynamic", "episode_time_s", "seed", "turbulence", "wind_kt")
-AUTOPILOT = (*FLIGHT, "episodes", "agent_hz", "noise", "out")
-MANUAL = (*FLIGHT, "device", "agent_hz", "episodes", "assist", "out", "view", "pilot", "skill")
+CAMERA = ("images", "image_size")
+AUTOPILOT = (*FLIGHT, "episodes", "agent_hz", "noise", "out", *CAMERA)
+MANUAL = (
+    *FLIGHT, "device", "agent_hz", "episodes", "assist", "out", "view", "pilot", "skill",
+    *CAMERA, "pilot_view",
+)  # fmt: skip
 RECIPE = tuple(dict.fromkeys(AUTOPILOT + MANUAL))
 
 
@@ -207,6 +211,9 @@ def _fly_by_hand(cfg: object, show_progress: bool = True) -> int:
         cfg.seed,
         cfg.episodes,
         views=tuple(cfg.view),
+        images=cfg.images,
+        image_size=cfg.image_size,
+        pilot_view=None if cfg.pilot_view == "none" else cfg.pilot_view,
         **synthetic,  # type: ignore[arg-type]
     )
     try:

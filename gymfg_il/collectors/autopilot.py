@@ -55,6 +55,8 @@ def record_autopilot(
         noise=cfg.noise,
         workers=workers,
         progress=progress,
+        images=cfg.images,
+        image_size=cfg.image_size,
     )
 
 

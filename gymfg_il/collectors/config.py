@@ -12,6 +12,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Literal
 
+from gymfg_il.datasets.videos import check_views
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ
@@ -44,6 +45,13 @@ class CollectConfig:
             A policy cloned from still-air demonstrations drifts off its target in turbulence.
         wind_kt: a steady wind from a direction drawn per episode.
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
+        images: camera views to add to the dataset as LeRobot video features
+            ``observation.images.<view>``: ``front`` (the pilot's eye) and/or ``chase``
+            (``--images front`` or ``--images front chase``); drawn from the logged states
+            by the headless camera (``viz.camera``). Default: none, state only.
+        image_size: side of the square camera frames, in pixels.
+        pilot_view: manual only: the camera the window shows beside the instruments
+            (``front``, ``chase``, or ``none``), so a person can fly without FlightGear.
         task_kwargs: arguments of the task class (e.g. ``target_range``).
         device: manual only: keyboard, mouse or joystick.
         assist: manual only: ``controller`` or a policy folder that flies until the person
@@ -71,6 +79,9 @@ class CollectConfig:
     turbulence: Literal["none", "light", "moderate", "severe"] = "none"
     wind_kt: float = 0.0
     out: Path = Path("datasets/autopilot")
+    images: list[str] = field(default_factory=list)
+    image_size: int = 128
+    pilot_view: Literal["front", "chase", "none"] = "front"
     task_kwargs: dict[str, Any] = field(default_factory=dict)
     device: Literal["keyboard", "mouse", "joystick"] = "keyboard"
     assist: str | None = None
@@ -111,6 +122,13 @@ class CollectConfig:
         ):
             problems.append(f"noise={self.noise!r} must be a number >= 0")
         problems += [f"view port {p}: want 1..65535" for p in self.view if not 0 < p < 65536]
+        self.images = [v for item in self.images for v in str(item).split(",") if v]
+        try:
+            check_views(self.images)
+        except ConfigError as err:
+            problems.append(str(err))
+        if not 16 <= self.image_size <= 1024:
+            problems.append(f"image_size={self.image_size}: want 16..1024 pixels")
         if not 0.0 <= self.skill <= 1.0:
             problems.append(f"skill={self.skill}: want 0 (a novice) .. 1 (an ace)")
         if problems:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -21,6 +21,7 @@ import numpy as np
 
 from gymfg_il.collectors.session import DATASET, check_appendable, check_out_folder
 from gymfg_il.collectors.updater import DatasetUpdater
+from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.manual.bindings import (
@@ -38,6 +39,8 @@ from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.loop import Rollout
 from gymfg_il.sim.properties import BY_NAME, INDEX
+from gymfg_il.tasks.scenery import landmarks_of
+from gymfg_il.viz.camera import Camera
 
 log = logging.getLogger(__name__)
 
@@ -131,6 +134,9 @@ class ManualSession:
         build_each: bring the dataset up to date after every saved episode (a person's
             session, so that quitting loses nothing); else once, at the end (the log keeps
             every episode durable either way).
+        images, image_size: camera views the dataset holds as video (``datasets.videos``).
+        pilot_view: the camera the window shows beside the instruments (``front``, ``chase``),
+            so a person can fly without FlightGear; ``None``: instruments only.
     """
 
     def __init__(
@@ -148,6 +154,9 @@ class ManualSession:
         source: str | None = None,
         draw: bool = True,
         build_each: bool = True,
+        images: Sequence[str] = (),
+        image_size: int = DEFAULT_IMAGE_SIZE,
+        pilot_view: str | None = "front",
     ) -> None:
         bindings = bindings or {}
         out = Path(out)
@@ -155,7 +164,8 @@ class ManualSession:
         self.flight, self.out, self.seed, self.max_episodes = flight, out, seed, max_episodes
         self.realtime, self.on_frame = realtime, on_frame
         self.env = flight.make_env(list(views) or None)
-        check_appendable(out, self.env.observation_names, flight.agent_hz)
+        self.images, self.image_size = list(images), image_size
+        check_appendable(out, self.env.observation_names, flight.agent_hz, None, images, image_size)
         self.kb = from_table(KeyboardBindings, bindings.get("keyboard"), "[collector.keyboard]")
         self.human = ManualController(
             device,
@@ -182,7 +192,8 @@ class ManualSession:
         self.draw, self.build_each = draw, build_each
         self.help = help_lines(device, self.kb)
         title = f"GymFG-IL: {flight.task_label} on {self.env.aircraft.model}"
-        self.gui = ControlsGUI(title=title)
+        self.camera = Camera(320, 320, view=pilot_view) if pilot_view and draw else None
+        self.gui = ControlsGUI(size=(1250, 600) if self.camera else (900, 600), title=title)
         self.human.window_size = self.gui.size
         self.stats = SessionStats()
         self.state = "idle"
@@ -206,7 +217,13 @@ class ManualSession:
     # -- episodes --------------------------------------------------------------------------
     def _writer(self) -> TrajectoryWriter:
         if self.writer is None:
-            record = session_record(self.flight, self.source, device=self.human.device)
+            record = session_record(
+                self.flight,
+                self.source,
+                device=self.human.device,
+                images=self.images,
+                image_size=self.image_size,
+            )
             self.writer = TrajectoryWriter(new_log_path(self.out, "manual"), record)
         return self.writer
 
@@ -299,6 +316,11 @@ class ManualSession:
             message=self.message or self.human.status,
             help_lines=self.help,
             show_help=self.show_help,
+            view=None
+            if self.camera is None
+            else self.camera.frame(
+                state, landmarks_of(env.task, getattr(env.task, "plan", None), env.world.steps)
+            ),
         )
         self.gui.draw(frame)
 

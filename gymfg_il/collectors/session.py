@@ -15,6 +15,7 @@ from pathlib import Path
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.features import check_compatible, dataset_features
+from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.recorder import LOGS, new_log_path
@@ -62,7 +63,12 @@ def check_out_folder(out: Path) -> None:
 
 
 def check_appendable(
-    out: Path, observation_names: Sequence[str], fps: int, flight: FlightSpec | None = None
+    out: Path,
+    observation_names: Sequence[str],
+    fps: int,
+    flight: FlightSpec | None = None,
+    images: Sequence[str] = (),
+    image_size: int = DEFAULT_IMAGE_SIZE,
 ) -> None:
     """Refuse, before flying anything, to collect data the existing dataset cannot take; warn
     when it holds another flight (a policy trained on both has no single flight to fly)."""
@@ -70,7 +76,8 @@ def check_appendable(
     if not (root / "meta" / "info.json").is_file():
         return
     meta = lr.open_metadata(root)
-    check_compatible(meta.features, dataset_features(observation_names), str(root))
+    wanted = dataset_features(observation_names, images, image_size)
+    check_compatible(meta.features, wanted, str(root))
     if meta.fps != fps:
         raise ConfigError(f"the dataset at {root} is at {meta.fps} fps, not {fps}")
     episodes = meta.episodes
@@ -129,13 +136,18 @@ def record_session(
     workers: int | Workers = 1,
     iteration: int = 0,
     progress: Callable[[int, float], None] | None = None,
+    images: Sequence[str] = (),
+    image_size: int = DEFAULT_IMAGE_SIZE,
 ) -> SessionResult:
     """Fly one episode of ``flight`` per seed and log them to a new MCAP log under
-    ``out/logs``; ``progress(i, return)`` is called once each episode is durable."""
+    ``out/logs``; ``progress(i, return)`` is called once each episode is durable. ``images``:
+    the camera views the dataset built from the log draws (``datasets.videos``)."""
     check_out_folder(out)
-    record = session_record(flight, source, noise=noise, iteration=iteration)
+    record = session_record(
+        flight, source, noise=noise, iteration=iteration, images=list(images), image_size=image_size
+    )
     names = record["aircraft"]["ego"]["observation_names"]
-    check_appendable(out, names, flight.agent_hz, flight)
+    check_appendable(out, names, flight.agent_hz, flight, images, image_size)
     episodes: list[Episode] = []
     if not seeds:
         return SessionResult(None, episodes)

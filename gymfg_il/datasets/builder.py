@@ -18,6 +18,7 @@ import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.features import check_compatible
+from gymfg_il.datasets.videos import VideoTrack
 from gymfg_il.errors import ConfigError
 
 
@@ -60,6 +61,8 @@ class DatasetBuilder:
                 root.rmdir()
             meta = lr.create_metadata(root, repo_id, fps, features, robot_type)
         self.meta = meta
+        self.video_keys = [k for k, f in features.items() if f.get("dtype") == "video"]
+        self._tracks: dict[str, VideoTrack] = {}
         self._writer: Any = None
         self._schema: Any = None
         self._file: tuple[int, int] | None = None
@@ -81,10 +84,32 @@ class DatasetBuilder:
         shape = tuple(self.meta.features[key]["shape"])
         return () if shape == (1,) else shape
 
+    def _track(self, key: str) -> VideoTrack:
+        """The camera's video file of this build: the one after the newest existing file."""
+        track = self._tracks.get(key)
+        if track is None:
+            chunk, file = 0, 0
+            episodes = self.meta.episodes
+            column = f"videos/{key}/chunk_index"
+            if episodes is not None and len(episodes) > 0 and column in episodes.column_names:
+                last = episodes[-1]
+                chunk, file = lr.next_data_file(
+                    last[column], last[f"videos/{key}/file_index"], self.meta.chunks_size
+                )
+            path = lr.video_path(self.meta, key, chunk, file)
+            track = self._tracks[key] = VideoTrack(path, self.meta.fps, lr.video_encoder())
+            track.location = (chunk, file)
+        return track
+
     def add_episode(
-        self, columns: dict[str, np.ndarray], task: str, metadata: dict[str, Any] | None = None
+        self,
+        columns: dict[str, np.ndarray],
+        task: str,
+        metadata: dict[str, Any] | None = None,
+        images: dict[str, np.ndarray] | None = None,
     ) -> int:
-        """Append one episode; ``columns`` maps each of our features to a (frames, ...) array."""
+        """Append one episode; ``columns`` maps each of our features to a (frames, ...) array,
+        ``images`` each camera feature to its (frames, H, W, 3) uint8 frames."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
@@ -108,6 +133,26 @@ class DatasetBuilder:
             "task_index": np.full(n, lr.task_index(meta, task), dtype=np.int64),
         }
         stats = lr.episode_stats(frames, meta.features)
+        videos: dict[str, Any] = {}
+        missing = sorted(set(self.video_keys) - set(images or {}))
+        if missing:
+            raise ConfigError(
+                f"the dataset has camera features {missing} but the episode has no frames for them"
+            )
+        for key in self.video_keys:
+            pictures = (images or {})[key]
+            if len(pictures) != n:
+                raise ConfigError(f"{key}: {len(pictures)} frames for an episode of {n}")
+            stats[key] = lr.image_stats(pictures)
+            track = self._track(key)
+            begin, end = track.add(pictures)
+            chunk, file = track.location
+            videos |= {
+                f"videos/{key}/chunk_index": chunk,
+                f"videos/{key}/file_index": file,
+                f"videos/{key}/from_timestamp": begin,
+                f"videos/{key}/to_timestamp": end,
+            }
         if self._schema is None:
             self._schema = lr.arrow_schema(meta.features)
         arrays = []
@@ -132,6 +177,7 @@ class DatasetBuilder:
             "data/file_index": file,
             "dataset_from_index": start,
             "dataset_to_index": start + n,
+            **videos,
             **{f"gymfg/{k}": v for k, v in (metadata or {}).items()},
         }
         lr.save_episode(meta, index, n, task, stats, episode_meta)
@@ -143,4 +189,9 @@ class DatasetBuilder:
         if self._writer is not None:
             self._writer.close()
             self._writer = None
+        tracks, self._tracks = self._tracks, {}
+        for track in tracks.values():
+            track.close()
+        for key in tracks:
+            lr.record_video_info(self.meta, key, lr.video_encoder())
         self.meta.finalize()

@@ -7,6 +7,7 @@
 | next.reward | float32 | (1,) | reward of the step |
 | next.done | bool | (1,) | the episode ended with this step |
 | intervention | bool | (1,) | a human flew this step (human takeover / DAgger) |
+| observation.images.<view> | video | (H, W, 3) | camera frames, only with ``images`` |
 
 Plus LeRobot's own ``timestamp``, ``frame_index``, ``episode_index``, ``index``, ``task_index``
 and a ``task`` string per frame.
@@ -23,8 +24,21 @@ from gymfg_il.sim.properties import ACTION_NAMES
 OUR_KEYS = ("observation.state", "action", "next.reward", "next.done", "intervention")
 
 
-def dataset_features(observation_names: Sequence[str]) -> dict[str, dict[str, Any]]:
+def dataset_features(
+    observation_names: Sequence[str], images: Sequence[str] = (), image_size: int = 128
+) -> dict[str, dict[str, Any]]:
+    """Our features for a task observing ``observation_names``, with the camera ``images``
+    (views) as square video features of ``image_size`` pixels."""
+    videos = {
+        f"observation.images.{view}": {
+            "dtype": "video",
+            "shape": (image_size, image_size, 3),
+            "names": ["height", "width", "channels"],
+        }
+        for view in images
+    }
     return {
+        **videos,
         "observation.state": {
             "dtype": "float32",
             "shape": (len(observation_names),),
@@ -42,7 +56,12 @@ def check_compatible(
 ) -> None:
     """Appending needs identical features; say exactly what differs."""
     problems = []
-    for key in OUR_KEYS:
+    cameras = [
+        sorted(k for k, v in f.items() if v.get("dtype") == "video") for f in (existing, wanted)
+    ]
+    if cameras[0] != cameras[1]:
+        problems.append(f"camera features: existing {cameras[0]}, new {cameras[1]}")
+    for key in (*OUR_KEYS, *cameras[1]):
         have, want = existing.get(key), wanted[key]
         if have is None:
             problems.append(f"{key} is missing from the existing dataset")

@@ -23,8 +23,10 @@ from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.features import dataset_features
 from gymfg_il.datasets.health import dataset_problems
+from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views, episode_frames, image_key
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import EmptyLog, Log, LoggedEpisode, read_log
+from gymfg_il.viz.camera import Camera
 
 log = logging.getLogger(__name__)
 
@@ -138,9 +140,12 @@ def build_from_logs(
     root: Path,
     repo_id: str | None = None,
     callsigns: Sequence[str] | None = None,
+    images: Sequence[str] | None = None,
 ) -> BuildReport:
     """Make the dataset at ``root`` hold every completed episode of ``log_paths``: one
     dataset episode per aircraft and logged episode (``callsigns``: only these aircraft).
+    ``images``: camera views to draw as video features (default: what the session asked for,
+    its record's ``images``; ``datasets.videos``).
 
     Episodes already in the dataset (by log file, episode and callsign) are kept; a dataset
     that cannot be read is set aside as ``<root>.broken-<time>`` and rebuilt from the logs.
@@ -149,14 +154,18 @@ def build_from_logs(
     enabled = gc.isenabled()
     gc.disable()
     try:
-        return _build(log_paths, Path(root), repo_id, callsigns)
+        return _build(log_paths, Path(root), repo_id, callsigns, images)
     finally:
         if enabled:
             gc.enable()
 
 
 def _build(
-    log_paths: Sequence[Path], root: Path, repo_id: str | None, callsigns: Sequence[str] | None
+    log_paths: Sequence[Path],
+    root: Path,
+    repo_id: str | None,
+    callsigns: Sequence[str] | None,
+    images: Sequence[str] | None,
 ) -> BuildReport:
     lr.load()  # LeRobot's import is not build time
     started = time.perf_counter()
@@ -173,7 +182,10 @@ def _build(
     chosen = _chosen(logs, callsigns)
     first_log, first = chosen[0]
     info = first_log.aircraft(first)
-    features = dataset_features(info["observation_names"])
+    views = check_views(first_log.session.get("images", []) if images is None else images)
+    size = int(first_log.session.get("image_size", DEFAULT_IMAGE_SIZE))
+    cameras = {image_key(v): Camera(size, size, view=v) for v in views}
+    features = dataset_features(info["observation_names"], views, size)
     fps = first_log.spec.agent_hz
     label = info["task"].get("task", "task")
     repo_id = repo_id or f"gymfg/{label}-{info['model']}"
@@ -206,10 +218,15 @@ def _build(
                     if (lg.path.name, episode.index, callsign) in present:
                         continue
                     columns = episode_columns(episode, callsign)
+                    pictures = {
+                        key: episode_frames(lg, episode, callsign, camera)
+                        for key, camera in cameras.items()
+                    }
                     builder.add_episode(
                         columns,
                         lg.aircraft(callsign)["task_description"],
                         episode_metadata(lg, episode, callsign),
+                        pictures,
                     )
                     added += 1
                     frames += len(columns["action"])

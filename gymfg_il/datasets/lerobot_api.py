@@ -72,7 +72,8 @@ def open_metadata(root: Path, repo_id: str = "gymfg/local") -> Any:
 def create_metadata(
     root: Path, repo_id: str, fps: int, features: dict[str, Any], robot_type: str | None
 ) -> Any:
-    """New dataset metadata at ``root`` (which must not exist), no videos."""
+    """New dataset metadata at ``root`` (which must not exist); videos only when a feature
+    is a camera."""
     check_version()
     from lerobot.datasets.dataset_metadata import LeRobotDatasetMetadata
 
@@ -82,8 +83,52 @@ def create_metadata(
         features=features,
         robot_type=robot_type,
         root=Path(root),
-        use_videos=False,
+        use_videos=any(f.get("dtype") == "video" for f in features.values()),
     )
+
+
+def video_encoder() -> Any:
+    """LeRobot's encoder settings for camera features: H.264 (yuv420p, crf 23) with a key
+    frame every 2 frames (LeRobot's default, for random access) and the fastest preset
+    (``datasets.videos`` gives the figures)."""
+    check_version()
+    from lerobot.configs.video import RGBEncoderConfig
+
+    return RGBEncoderConfig(vcodec="h264", pix_fmt="yuv420p", g=2, crf=23, preset="ultrafast")
+
+
+def image_stats(frames: Any) -> dict[str, Any]:
+    """LeRobot's statistics of one episode's camera frames ((n, H, W, 3) uint8), as its own
+    writer computes them (the frames it samples, per channel, scaled to [0, 1], shape
+    (3, 1, 1)), over every 4th pixel of every 4th row: the quantiles of all pixels cost
+    ~1 s per 900-frame episode, of 1/16 of them ~0.05 s, and the figures agree within 0.015."""
+    check_version()
+    import numpy as np
+    from lerobot.datasets.compute_stats import (
+        auto_downsample_height_width,
+        get_feature_stats,
+        sample_indices,
+    )
+
+    chosen = frames[sample_indices(len(frames)), ::4, ::4].transpose(0, 3, 1, 2)
+    sampled = np.stack([auto_downsample_height_width(img) for img in chosen])
+    stats = get_feature_stats(sampled, axis=(0, 2, 3), keepdims=True)
+    return {k: v if k == "count" else np.squeeze(v / 255.0, axis=0) for k, v in stats.items()}
+
+
+def video_path(meta: Any, key: str, chunk: int, file: int) -> Path:
+    return Path(meta.root) / meta.video_path.format(
+        video_key=key, chunk_index=chunk, file_index=file
+    )
+
+
+def record_video_info(meta: Any, key: str, encoder: Any) -> None:
+    """Probe the camera's first video file and record codec, size and encoder in
+    ``info.json``, as LeRobot's writer does after its first episode."""
+    from lerobot.datasets.io_utils import write_info
+
+    meta.update_video_info(key, video_encoder=encoder)
+    write_info(meta.info, meta.root)
 
 
 def open_dataset(root: Path, repo_id: str = "gymfg/local") -> Any:

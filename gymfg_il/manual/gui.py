@@ -33,6 +33,7 @@ class GuiFrame:
     message: str = ""
     help_lines: list[str] = field(default_factory=list)
     show_help: bool = False
+    view: np.ndarray | None = None  # the camera's frame (H, W, 3) uint8, beside the instruments
 
 
 class ControlsGUI:
@@ -116,6 +117,13 @@ class ControlsGUI:
             self._text(name, (40, y), DIM, self.small)
             self._text(f"{value:12.3f} {unit}", (200, y), FG, self.small)
             y += 18
+        if f.view is not None:
+            # the pilot's view, right of the instruments
+            h, w = f.view.shape[:2]
+            image = pg.image.frombuffer(np.ascontiguousarray(f.view).tobytes(), (w, h), "RGB")
+            s.blit(image, (self.size[0] - w - 20, 100))
+            pg.draw.rect(s, DIM, (self.size[0] - w - 21, 99, w + 2, h + 2), 1)
+            self._text("pilot's view", (self.size[0] - w - 20, 76), DIM, self.small)
         if f.message:
             self._text(f.message, (40, self.size[1] - 34), AMBER)
         self._text("H: help", (self.size[0] - 80, self.size[1] - 30), DIM, self.small)

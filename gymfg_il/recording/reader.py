@@ -86,7 +86,9 @@ class LoggedEpisode:
         return ""
 
     def start_of(self, callsign: str) -> dict[str, Any]:
-        """``callsign``'s start: ``target`` and ``initial_state`` (older logs: the episode's)."""
+        """``callsign``'s start: ``target``, ``initial_state`` (position) and, in logs since
+        the camera, ``state`` (the whole catalogue) and the task's ``plan`` (older logs: the
+        episode's target and position)."""
         aircraft = self.start.get("aircraft")
         if isinstance(aircraft, dict) and callsign in aircraft:
             return dict(aircraft[callsign])

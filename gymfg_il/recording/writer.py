@@ -32,6 +32,19 @@ _FT_TO_M = 0.3048
 _INITIAL = ("lat_deg", "lon_deg", "altitude_ft")
 
 
+def _start_record(s: Start) -> dict[str, Any]:
+    """One aircraft's start as the log keeps it: target, position, the whole catalogue
+    state (a camera redraws the first frame from it) and the task's plan, if it has one."""
+    record = {
+        "target": s.target,
+        "initial_state": dict(zip(_INITIAL, s.state[:3].tolist(), strict=True)),
+        "state": s.state.tolist(),
+    }
+    if s.task.get("plan") is not None:
+        record["plan"] = s.task["plan"]
+    return record
+
+
 def step_topic(callsign: str) -> str:
     return f"/gymfg/{callsign}/step"
 
@@ -149,13 +162,7 @@ class TrajectoryWriter:
         self.episode += 1
         self._in_episode = True
         self._base_ns = self._clock_ns
-        aircraft = {
-            s.callsign: {
-                "target": s.target,
-                "initial_state": dict(zip(_INITIAL, s.state[:3].tolist(), strict=True)),
-            }
-            for s in starts
-        }
+        aircraft = {s.callsign: _start_record(s) for s in starts}
         event = {"event": "start", "episode": self.episode, "seed": seed, "aircraft": aircraft}
         if options:
             event["options"] = dict(options)

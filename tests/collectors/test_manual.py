@@ -60,8 +60,8 @@ def test_keyboard_rates_and_centring_reach_the_dataset(tmp_path):
 
 def test_mouse_is_the_stick(tmp_path):
     move = pygame.event.Event(
-        pygame.MOUSEMOTION, pos=(450 + 100, 300 - 50), rel=(0, 0), buttons=(0, 0, 0)
-    )
+        pygame.MOUSEMOTION, pos=(625 + 100, 300 - 50), rel=(0, 0), buttons=(0, 0, 0)
+    )  # the window (1,250 x 600 with the pilot's view) centres the stick
     script = {1: [lambda: key(pygame.K_SPACE)], 5: [move], 200: [lambda: key(pygame.K_q)]}
     run(tmp_path, script, device="mouse")
     frames = load_frames(tmp_path / "dataset")
@@ -160,6 +160,32 @@ def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
     flying = [f for f in drawn if f.status != "idle"]
     assert flying and all(f.target_name == "altitude_ft (ft)" for f in flying)
     assert all(abs(f.target - f.actual) <= 1000 for f in flying)
+
+
+def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
+    shots = {}
+
+    def on_frame(frame, session):
+        if frame == 1:
+            key(pygame.K_SPACE)
+        if frame in (2, 25):
+            shots[frame] = pygame.surfarray.array3d(session.gui.screen).transpose(1, 0, 2)
+        if frame < 25:
+            key(pygame.K_RIGHT)  # roll right: the horizon in the view turns
+        if frame == 30:
+            key(pygame.K_q)
+
+    session = ManualSession(SPEC, tmp_path, realtime=False, on_frame=on_frame)
+    assert session.gui.size == (1250, 600) and session.camera is not None
+    session.run(max_frames=40)
+    # the view's box right of the instruments: sky on top (blue), ground below (green)
+    for shot in shots.values():
+        view = shot[100:420, 1250 - 340 : 1250 - 20].astype(int)
+        assert (view[20:60, :, 2] > view[20:60, :, 1]).mean() > 0.9
+    # after rolling, the view changed
+    assert np.abs(shots[2][100:420, 910:1230].astype(int) - shots[25][100:420, 910:1230]).mean() > 3
+    headless = ManualSession(SPEC, tmp_path / "b", realtime=False, pilot_view=None)
+    assert headless.gui.size == (900, 600) and headless.camera is None
 
 
 def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
