@@ -34,13 +34,13 @@ def main(argv: list[str] | None = None) -> int:
 def _bc(cfg: object, show_progress: bool) -> int:
     from gymfg_il import cli
     from gymfg_il.datasets.lerobot_api import hub_offline
-    from gymfg_il.learning.bc import TrainConfig, default_epochs, train_bc
+    from gymfg_il.learning.bc import TrainConfig, epochs_for, train_bc
     from gymfg_il.learning.data import load_frames
 
     assert isinstance(cfg, TrainConfig)
     hub_offline()
-    frames = load_frames(cfg.dataset)
-    epochs = cfg.epochs or default_epochs(frames)
+    frames = load_frames(cfg.dataset, cfg.camera if cfg.policy == "vision" else None)
+    epochs = epochs_for(cfg, frames)
     bar = cli.progress_bar(epochs, "epochs", "ep", show_progress)
 
     def on_epoch(epoch: int, train: float, val: float) -> None:

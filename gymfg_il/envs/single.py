@@ -140,6 +140,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         self.metadata = {**type(self).metadata, "render_fps": agent_hz}
         self.camera = Camera(*render_size, view=camera)
         self._window: FrameWindow | None = None
+        self._cameras: dict[tuple[str, int], Camera] = {}
         self._done = True
 
     @classmethod
@@ -219,16 +220,28 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         if self.render_mode is None:
             gym.logger.warn("render() needs a render_mode (rgb_array or human) at make()")
             return None
-        task = self.task
-        frame = self.camera.frame(
-            self._slot.state, landmarks_of(task, getattr(task, "plan", None), self.world.steps)
-        )
+        frame = self._draw(self.camera)
         if self.render_mode == "rgb_array":
             return frame
         if self._window is None:
-            self._window = FrameWindow(fps=self.metadata["render_fps"], title=f"GymFG {task.name}")
+            title = f"GymFG {self.task.name}"
+            self._window = FrameWindow(fps=self.metadata["render_fps"], title=title)
         self._window.show(frame)
         return None
+
+    def camera_frame(self, view: str = "front", size: int = 128) -> np.ndarray:
+        """A square frame of ``size`` pixels from the ``view`` camera of the current state,
+        with the task's landmarks: what a vision policy sees (``render()`` draws the env's
+        own ``camera``)."""
+        camera = self._cameras.get((view, size))
+        if camera is None:
+            camera = self._cameras[(view, size)] = Camera(size, size, view=view)
+        return self._draw(camera)
+
+    def _draw(self, camera: Camera) -> np.ndarray:
+        task = self.task
+        marks = landmarks_of(task, getattr(task, "plan", None), self.world.steps)
+        return camera.frame(self._slot.state, marks)
 
     def close(self) -> None:
         if self._window is not None:

@@ -11,6 +11,8 @@ from pathlib import Path
 from typing import Any, Literal
 
 from gymfg_il.collectors.session import DATASET, LOGS, record_session
+from gymfg_il.datasets import lerobot_api as lr
+from gymfg_il.datasets.videos import IMAGE_PREFIX
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.rollout.agents import AgentSpec
@@ -106,6 +108,11 @@ def run_dagger(
             raise ConfigError(f"the policy's dataset {base} is gone; DAgger aggregates onto it")
         out.mkdir(parents=True, exist_ok=True)
         shutil.copytree(base, root)
+    # a camera dataset stays one: the new rounds draw the same views at the same size
+    root_meta = lr.open_metadata(root)
+    cameras = root_meta.video_keys
+    views = [k.removeprefix(IMAGE_PREFIX) for k in cameras]
+    size = int(root_meta.features[cameras[0]]["shape"][0]) if cameras else 128
     known = {f.name for f in fields(TrainConfig)}
     train_args = {k: v for k, v in meta.get("train", {}).items() if k in known}
     train_args.update(train_overrides or {})
@@ -124,6 +131,8 @@ def run_dagger(
                 "dagger",
                 workers=pool,
                 iteration=it,
+                images=views,
+                image_size=size,
             )
             report = build_from_logs(sorted((out / LOGS).glob("*.mcap")), root)
             cfg = TrainConfig(**{**train_args, "dataset": root, "out": out / f"policy-{it}"})

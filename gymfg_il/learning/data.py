@@ -16,6 +16,7 @@ import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.health import dataset_problems
+from gymfg_il.datasets.videos import decode_camera, image_key
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, join_problems
 
@@ -35,6 +36,8 @@ class Frames:
     action_stats: dict[str, np.ndarray]
     episodes: dict[str, list[Any]] = field(default_factory=dict)  # per-episode metadata
     intervention: np.ndarray | None = None  # (N,) bool: a person took over from a policy
+    images: np.ndarray | None = None  # (N, H, W, 3) uint8: one camera, when asked for
+    camera: str | None = None  # which (``front``, ``chase``)
 
     def __len__(self) -> int:
         return len(self.action)
@@ -89,6 +92,8 @@ class Frames:
             self.action_stats,
             self.episodes,
             None if self.intervention is None else self.intervention[keep],
+            None if self.images is None else self.images[keep],
+            self.camera,
         )
 
 
@@ -104,8 +109,9 @@ def _column(table: Any, name: str) -> np.ndarray:
     return col.to_numpy(zero_copy_only=False)
 
 
-def load_frames(root: Path) -> Frames:
-    """Open the LeRobot dataset at ``root`` and take its frames into memory."""
+def load_frames(root: Path, camera: str | None = None) -> Frames:
+    """Open the LeRobot dataset at ``root`` and take its frames into memory (``camera``:
+    with that view's frames, decoded, ``observation.images.<camera>``)."""
     root = Path(root)
     if not (root / "meta").is_dir() and (root / "dataset" / "meta").is_dir():
         root = root / "dataset"  # a session folder: its dataset is inside
@@ -149,6 +155,8 @@ def load_frames(root: Path) -> Frames:
             if "intervention" in features
             else None
         ),
+        images=None if camera is None else decode_camera(root, image_key(camera), ds.meta),
+        camera=camera,
     )
 
 
@@ -194,8 +202,10 @@ def chunk_indices(
 
 class TensorBatches:
     """Shuffled batches from tensors on ``device``: frames, windows of ``sequence`` steps
-    that never cross an episode boundary, or (``chunks`` = (history, chunk)) observation
-    histories with the action chunks that follow them (NaN past an episode's end)."""
+    that never cross an episode boundary, (``chunks`` = (history, chunk)) observation
+    histories with the action chunks that follow them (NaN past an episode's end), or
+    (``stack`` = n) the last n camera frames (averaged over ``pool`` x ``pool`` pixels) with
+    the observation, as ``(frames, obs)``."""
 
     def __init__(
         self,
@@ -205,6 +215,8 @@ class TensorBatches:
         sequence: int | None = None,
         seed: int = 0,
         chunks: tuple[int, int] | None = None,
+        stack: int | None = None,
+        pool: int = 1,
     ) -> None:
         import torch
 
@@ -214,6 +226,18 @@ class TensorBatches:
         self.batch_size = batch_size
         self.sequence = sequence
         self.chunks = None
+        self.images: Any = None
+        self.past: Any = None
+        if stack is not None:
+            if frames.images is None:
+                raise ConfigError("a vision policy needs the dataset's camera frames")
+            from gymfg_il.policies.modeling_vision import pool_frames
+
+            images = torch.as_tensor(frames.images)
+            self.images = torch.cat(
+                [pool_frames(images[i : i + 4096], pool) for i in range(0, len(images), 4096)]
+            ).to(device)
+            self.past = torch.as_tensor(chunk_indices(frames, stack, 1)[0], device=device)
         if chunks is not None:
             past, ahead, inside = chunk_indices(frames, *chunks)
             future = frames.action[ahead]
@@ -250,4 +274,7 @@ class TensorBatches:
             idx = order[i : i + self.batch_size]
             if self.sequence is not None:
                 idx = idx[:, None] + self.offsets
+            if self.images is not None:
+                yield (self.images[self.past[idx]], self.obs[idx]), self.action[idx]
+                continue
             yield self.obs[idx], self.action[idx]

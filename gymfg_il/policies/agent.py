@@ -3,7 +3,7 @@ episode."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +23,9 @@ class PolicyAgent:
         self.observation_names: list[str] = list(meta["observation_names"])
         self._torch = torch
         self._state: object = None
+        # a vision policy's eyes: the env's camera of the current state (``AgentSpec.make``)
+        self.camera: dict[str, Any] | None = meta.get("camera")
+        self.see: Callable[[], np.ndarray] | None = None
 
     @classmethod
     def load(cls, path: Path, device: str = "cpu") -> PolicyAgent:
@@ -49,7 +52,16 @@ class PolicyAgent:
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
         torch = self._torch
         obs = torch.as_tensor(np.asarray(observation, dtype=np.float32), device=self.device)
-        action, self._state = self.policy.act(obs.unsqueeze(0), self._state)
+        inputs: Any = obs.unsqueeze(0)
+        if self.camera is not None:
+            if self.see is None:
+                raise ConfigError(
+                    f"{self.name} flies by its camera ({self.camera['view']}): fly it in a "
+                    "GymFG env (eval, collect dagger), which gives it the camera's frames"
+                )
+            frame = torch.as_tensor(self.see(), device=self.device)
+            inputs = (frame.unsqueeze(0), inputs)
+        action, self._state = self.policy.act(inputs, self._state)
         # the raw action: the rollout loop (or the env) clips it to the contract
         out: np.ndarray = action[0].double().cpu().numpy()
         return out

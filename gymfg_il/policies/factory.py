@@ -13,9 +13,15 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.policies.configuration_chunk import ChunkConfig
 from gymfg_il.policies.configuration_gru import GRUConfig
 from gymfg_il.policies.configuration_mlp import MLPConfig
+from gymfg_il.policies.configuration_vision import VisionConfig
 
-PolicyConfig = MLPConfig | GRUConfig | ChunkConfig
-CONFIGS: dict[str, type] = {"mlp": MLPConfig, "gru": GRUConfig, "chunk": ChunkConfig}
+PolicyConfig = MLPConfig | GRUConfig | ChunkConfig | VisionConfig
+CONFIGS: dict[str, type] = {
+    "mlp": MLPConfig,
+    "gru": GRUConfig,
+    "chunk": ChunkConfig,
+    "vision": VisionConfig,
+}
 CONFIG_FILE, WEIGHTS_FILE = "config.json", "model.safetensors"
 
 
@@ -41,6 +47,10 @@ def make_policy(
         from gymfg_il.policies.modeling_chunk import ChunkPolicy
 
         return ChunkPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
+    if config.type == "vision":
+        from gymfg_il.policies.modeling_vision import VisionPolicy
+
+        return VisionPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
     from gymfg_il.policies.modeling_gru import GRUPolicy
 
     return GRUPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]

@@ -76,4 +76,7 @@ class AgentSpec:
         assert self.path is not None
         agent = PolicyAgent.load(self.path)
         agent.check_observation(env.observation_names)
+        if agent.camera is not None:
+            view, size = agent.camera["view"], int(agent.camera["size"])
+            agent.see = lambda: env.camera_frame(view, size)
         return agent

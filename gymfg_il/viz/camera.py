@@ -74,6 +74,7 @@ _AIRCRAFT = np.array(
         [(-0.28, 0, 0), (-0.4, 0, 0), (-0.42, 0, -0.2), (-0.36, 0, -0.2)],
     ]
 )
+_MARKING = (235, 235, 235)
 _NEAR_FT = 1.0
 _CHASE_FT = (90.0, 0.0, -30.0)  # camera behind, right, below (negative: above) the aircraft
 
@@ -206,7 +207,9 @@ class Camera:
         cos_lat: float,
         items: list[Landmark],
     ) -> None:
-        polygons: list[tuple[float, np.ndarray, tuple[int, int, int]]] = []
+        # (item's distance, layer, quad's distance) orders the painting: far items first, an
+        # item's markings over its surface, its nearer faces over its farther ones
+        polygons: list[tuple[tuple[float, int, float], np.ndarray, tuple[int, ...]]] = []
         world_to_cam = rot.T
         for item in items:
             offset = (
@@ -220,7 +223,8 @@ class Camera:
                 - eye
             )
             colour = _COLOURS.get(item.kind, (255, 0, 255))
-            for k, quad in enumerate(_shape(item)):
+            depth = float((offset @ world_to_cam.T)[0])
+            for k, (quad, layer) in enumerate(_shape(item)):
                 cam = (quad + offset) @ world_to_cam.T  # (forward, right, down)
                 if np.any(cam[:, 0] < _NEAR_FT):
                     continue
@@ -231,11 +235,10 @@ class Camera:
                     ],
                     axis=1,
                 )
-                shade = 1.0 - 0.12 * (k % 2)
-                tint = tuple(int(c * shade) for c in colour)
-                polygons.append((float(cam[:, 0].mean()), px, tint))  # type: ignore[arg-type]
-        for _, px, tint in sorted(polygons, key=lambda p: -p[0]):
-            self._fill(image, px, tint)
+                tint = _MARKING if layer else tuple(int(c * (1.0 - 0.12 * (k % 2))) for c in colour)
+                polygons.append(((-depth, layer, -float(cam[:, 0].mean())), px, tint))
+        for _, px, tint in sorted(polygons, key=lambda p: p[0]):
+            self._fill(image, px, tint)  # type: ignore[arg-type]
 
     def _fill(self, image: np.ndarray, px: np.ndarray, colour: tuple[int, int, int]) -> None:
         """Fill the convex polygon with vertices ``px`` (x, y pixels, either winding)."""
@@ -254,15 +257,29 @@ class Camera:
         image[y0:y1, x0:x1][inside_pos | inside_neg] = colour
 
 
-def _shape(item: Landmark) -> list[np.ndarray]:
-    """Quads (4 x 3 points, north-east-down ft, about the item's position) that draw it."""
+def _shape(item: Landmark) -> list[tuple[np.ndarray, int]]:
+    """Quads (4 x 3 points, north-east-down ft, about the item's position) that draw it, each
+    with its layer: 0 the surface, 1 a white marking painted on it."""
     rot = rotation(item.roll_deg, item.pitch_deg, item.heading_deg)
     w, length = item.width_ft, item.length_ft
     body: list[Any]
+    marks: list[Any] = []
     if item.kind == "runway":
         body = [
             [(0.0, -w / 2, 0.0), (length, -w / 2, 0.0), (length, w / 2, 0.0), (0.0, w / 2, 0.0)]
         ]
+        # threshold bar, then the centre line's dashes
+        marks = [
+            [
+                (20.0, -0.45 * w, 0.0),
+                (80.0, -0.45 * w, 0.0),
+                (80.0, 0.45 * w, 0.0),
+                (20.0, 0.45 * w, 0.0),
+            ]
+        ]
+        for x in np.arange(200.0, length - 150.0, 400.0):
+            c = 0.03 * w
+            marks.append([(x, -c, 0.0), (x + 150.0, -c, 0.0), (x + 150.0, c, 0.0), (x, c, 0.0)])
     elif item.kind == "gate":
         bar = max(w, length) * 0.06
         hw, hh = w / 2, length / 2
@@ -275,4 +292,8 @@ def _shape(item: Landmark) -> list[np.ndarray]:
     else:  # aircraft: the model's corners in (length, span, length) units
         scale = np.array([length, w / 2, length])
         body = [q * scale for q in _AIRCRAFT]
-    return [np.asarray(q, dtype=np.float64) @ rot.T for q in body]
+    return [
+        (np.asarray(q, dtype=np.float64) @ rot.T, layer)
+        for layer, quads in ((0, body), (1, marks))
+        for q in quads
+    ]

@@ -92,3 +92,21 @@ def test_bad_env_arguments():
         AircraftEnv("altitude", aircraft="cessna")
     with pytest.raises(ConfigError, match="render_mode"):
         AircraftEnv(render_mode="ansi")
+
+
+def test_human_render_mode_shows_the_camera_in_a_window():
+    from gymfg_il.envs.single import AircraftEnv
+
+    env = AircraftEnv("roll", render_mode="human", agent_hz=30, render_size=(64, 48))
+    assert env.render() is None  # human mode shows, returns nothing
+    env.reset(seed=0)
+    for _ in range(3):
+        env.step(np.array([0.3, 0.0, 0.0, 0.7], np.float32))
+    window = env._window
+    assert window is not None and window.fps == 30 and window.screen.get_size() == (512, 512)
+    shown = window.pg.surfarray.array3d(window.screen)
+    assert shown[:, :100, 2].mean() > shown[:, :100, 1].mean()  # sky on top
+    frame = env.camera_frame("chase", 32)
+    assert frame.shape == (32, 32, 3)
+    env.close()
+    assert env._window is None
