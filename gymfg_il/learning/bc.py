@@ -196,7 +196,6 @@ def _train(
     import torch
 
     from gymfg_il.learning.data import TensorBatches, load_frames, split_by_episode
-    from gymfg_il.learning.vision import WARM_EPOCHS, refresh_memory, stretch_starts
     from gymfg_il.policies.factory import make_config, make_policy, save_policy
 
     device = resolve_device(cfg.device)
@@ -283,10 +282,6 @@ def _train(
     started = time.perf_counter()
     for epoch in range(epochs):
         policy.train()
-        if cfg.policy == "vision" and epoch >= WARM_EPOCHS:
-            refresh_memory(policy, batches, stretch_starts(train))
-            if val_batches is not None and val is not None:
-                refresh_memory(policy, val_batches, stretch_starts(val))
         total, count = 0.0, 0
         for obs, act in batches:
             loss = policy.loss(obs, act)
