@@ -52,7 +52,7 @@ def test_a_vision_policy_trains_and_flies_by_the_envs_camera(roll_images, tmp_pa
     assert policy_cfg["policy"] == "vision"
     agent = PolicyAgent.load(tmp_path)
     assert agent.policy.config.state_names == ["roll_deg_target"]
-    assert agent.policy.config.memory_names == ["roll_deg_error_integral"]
+    assert agent.policy.config.memory_names == []
     with pytest.raises(ConfigError, match="camera"):
         agent.act(np.zeros(13, np.float32))  # outside an env it has no eyes
     from gymfg_il.envs.single import AircraftEnv
