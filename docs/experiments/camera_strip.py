@@ -15,7 +15,6 @@ from PIL import Image, ImageDraw
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.rollout.agents import AgentSpec
 
-
 TIMES_S = (0, 60, 100, 130, 155, 175)
 
 
