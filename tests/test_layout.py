@@ -25,7 +25,7 @@ LAYERS = [
     {"collectors"},
     {"learning"},
     {"evaluation"},
-    {"cli", "collect", "train", "eval", "serve", "demo"},
+    {"cli", "collect", "train", "eval", "serve", "demo", "lerobot_env"},
 ]
 LAYER = {name: i for i, names in enumerate(LAYERS) for name in names}
 

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
-from gymfg_il.datasets.features import check_compatible
+from gymfg_il.datasets.features import ENVIRONMENT_STATE, check_compatible, environment_indices
 from gymfg_il.datasets.videos import VideoTrack
 from gymfg_il.errors import ConfigError
 
@@ -61,6 +61,10 @@ class DatasetBuilder:
                 root.rmdir()
             meta = lr.create_metadata(root, repo_id, fps, features, robot_type)
         self.meta = meta
+        # the environment state is drawn from the observation (absent in older datasets)
+        self._environment: list[int] | None = None
+        if ENVIRONMENT_STATE in meta.features:
+            self._environment = environment_indices(meta.features["observation.state"]["names"])
         self.video_keys = [k for k, f in features.items() if f.get("dtype") == "video"]
         self._tracks: dict[str, VideoTrack] = {}
         self._writer: Any = None
@@ -108,8 +112,9 @@ class DatasetBuilder:
         metadata: dict[str, Any] | None = None,
         images: dict[str, np.ndarray] | None = None,
     ) -> int:
-        """Append one episode; ``columns`` maps each of our features to a (frames, ...) array,
-        ``images`` each camera feature to its (frames, H, W, 3) uint8 frames."""
+        """Append one episode; ``columns`` maps each of our features to a (frames, ...) array
+        (the environment state, when left out, is taken from ``observation.state``), ``images``
+        each camera feature to its (frames, H, W, 3) uint8 frames."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
@@ -117,6 +122,9 @@ class DatasetBuilder:
         n = len(columns["action"])
         if n == 0:
             raise ConfigError("an episode needs at least one frame")
+        if self._environment is not None and ENVIRONMENT_STATE not in columns:
+            state = np.asarray(columns["observation.state"])
+            columns = {**columns, ENVIRONMENT_STATE: state[:, self._environment]}
         index = meta.total_episodes
         start = meta.total_frames
         frames = {

@@ -3,11 +3,19 @@
 | feature | dtype | shape | meaning |
 | --- | --- | --- | --- |
 | observation.state | float32 | (n,) | the task's observation, ``names`` = its variable names |
+| observation.environment_state | float32 | (k,) | the task's own columns of it (targets, errors, |
+| | | | integrals, gates: every name that is not aircraft state), for LeRobot's ACT and diffusion |
 | action | float32 | (4,) | the demonstrator's [aileron, elevator, rudder, throttle] |
 | next.reward | float32 | (1,) | reward of the step |
 | next.done | bool | (1,) | the episode ended with this step |
 | intervention | bool | (1,) | a human flew this step (human takeover / DAgger) |
 | observation.images.<view> | video | (H, W, 3) | camera frames, only with ``images`` |
+
+``observation.environment_state`` repeats what ``observation.state`` already holds: LeRobot's
+ACT and diffusion policies need an image or an environment state among their inputs, and with
+the task's columns there (normalised: ``ENV`` in their ``normalization_mapping``) they train on
+our datasets unchanged. A task with no columns of its own has no environment state. Our own
+policies read ``observation.state`` only.
 
 Plus LeRobot's own ``timestamp``, ``frame_index``, ``episode_index``, ``index``, ``task_index``
 and a ``task`` string per frame.
@@ -19,9 +27,16 @@ from collections.abc import Sequence
 from typing import Any
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.sim.properties import ACTION_NAMES
+from gymfg_il.sim.properties import ACTION_NAMES, BY_NAME
 
 OUR_KEYS = ("observation.state", "action", "next.reward", "next.done", "intervention")
+ENVIRONMENT_STATE = "observation.environment_state"
+
+
+def environment_indices(observation_names: Sequence[str]) -> list[int]:
+    """Where the task's own columns (every name that is not an aircraft state variable of the
+    catalogue) sit in the observation."""
+    return [i for i, name in enumerate(observation_names) if name not in BY_NAME]
 
 
 def dataset_features(
@@ -37,6 +52,14 @@ def dataset_features(
         }
         for view in images
     }
+    task_columns = [observation_names[i] for i in environment_indices(observation_names)]
+    environment = {
+        ENVIRONMENT_STATE: {
+            "dtype": "float32",
+            "shape": (len(task_columns),),
+            "names": task_columns,
+        }
+    }
     return {
         **videos,
         "observation.state": {
@@ -44,6 +67,7 @@ def dataset_features(
             "shape": (len(observation_names),),
             "names": list(observation_names),
         },
+        **(environment if task_columns else {}),
         "action": {"dtype": "float32", "shape": (4,), "names": list(ACTION_NAMES)},
         "next.reward": {"dtype": "float32", "shape": (1,), "names": None},
         "next.done": {"dtype": "bool", "shape": (1,), "names": None},
@@ -61,10 +85,13 @@ def check_compatible(
     ]
     if cameras[0] != cameras[1]:
         problems.append(f"camera features: existing {cameras[0]}, new {cameras[1]}")
-    for key in (*OUR_KEYS, *cameras[1]):
-        have, want = existing.get(key), wanted[key]
-        if have is None:
-            problems.append(f"{key} is missing from the existing dataset")
+    # datasets made before the environment state existed are appended to without it
+    both = [ENVIRONMENT_STATE] if ENVIRONMENT_STATE in existing else []
+    for key in (*OUR_KEYS, *both, *cameras[1]):
+        have, want = existing.get(key), wanted.get(key)
+        if have is None or want is None:
+            where_missing = "the existing dataset" if have is None else "the new data"
+            problems.append(f"{key} is missing from {where_missing}")
             continue
         for attr in ("dtype", "shape", "names"):
             a, b = have.get(attr), want.get(attr)

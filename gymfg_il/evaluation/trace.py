@@ -58,37 +58,63 @@ def trace_of(episode: Episode, callsign: str | None = None, gusty: bool = False)
     """The trace of one aircraft of ``episode`` (the only one, unless ``callsign``);
     ``gusty``: it was flown in turbulence."""
     t = episode.solo if callsign is None else episode.trajectories[callsign]
-    task = t.start.task
+    return make_trace(
+        t.start.task,
+        episode.seed,
+        episode.dt,
+        t.next_observations,
+        t.actions,
+        t.rewards,
+        t.terminated,
+        t.reason,
+        np.vstack([t.start.state[None], t.states]),
+        gusty,
+    )
+
+
+def make_trace(
+    task: dict[str, Any],
+    seed: int,
+    dt: float,
+    next_observations: np.ndarray,
+    actions: np.ndarray,
+    rewards: np.ndarray,
+    terminated: bool,
+    reason: str | None,
+    states: np.ndarray,
+    gusty: bool = False,
+) -> Trace:
+    """The trace of one aircraft's flight: ``task`` is its ``Task.describe()``, ``states``
+    the catalogue states from the reset on (the start, then one per step)."""
     tracked = task.get("tracked")
     if not tracked:
         raise ConfigError(f"task {task.get('task')!r} has no target to evaluate against")
     names = list(task["observation"])
-    after = t.next_observations.astype(np.float64)
-    verdict, detail, states, plan = None, "", None, task.get("plan")
+    after = np.asarray(next_observations, dtype=np.float64).reshape(len(rewards), len(names))
+    verdict, detail, plan = None, "", task.get("plan")
     if plan is not None:
         from gymfg_il.tasks.library import task_class
 
-        states = np.vstack([t.start.state[None], t.states])
-        judged = task_class(task["task"]).judge(plan, states, episode.dt)  # type: ignore[attr-defined]
+        judged = task_class(task["task"]).judge(plan, states, dt)  # type: ignore[attr-defined]
         verdict, detail = judged.success, judged.detail
     value = after[:, names.index(tracked["variable"])]
     error = after[:, names.index(tracked["error"])]
     return Trace(
-        seed=episode.seed,
+        seed=seed,
         variable=tracked["variable"],
         tolerance=float(tracked["tolerance"]),
         dynamic=bool(tracked["dynamic"]),
-        dt=episode.dt,
+        dt=dt,
         target=value + error,
         value=value,
         error=error,
-        actions=t.actions,
-        rewards=t.rewards,
-        terminated=t.terminated,
-        reason=t.reason,
+        actions=np.asarray(actions),
+        rewards=np.asarray(rewards),
+        terminated=terminated,
+        reason=reason,
         gusty=gusty,
         verdict=verdict,
         detail=detail,
-        states=states,
+        states=states if plan is not None else None,
         plan=plan,
     )
