@@ -17,9 +17,10 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
-from gymfg_il.datasets.features import ENVIRONMENT_STATE, check_compatible, environment_indices
+from gymfg_il.datasets.features import ENVIRONMENT_STATE, check_compatible
 from gymfg_il.datasets.videos import VideoTrack
 from gymfg_il.errors import ConfigError
+from gymfg_il.sim.properties import task_columns
 
 
 class DatasetBuilder:
@@ -64,7 +65,7 @@ class DatasetBuilder:
         # the environment state is drawn from the observation (absent in older datasets)
         self._environment: list[int] | None = None
         if ENVIRONMENT_STATE in meta.features:
-            self._environment = environment_indices(meta.features["observation.state"]["names"])
+            self._environment = task_columns(meta.features["observation.state"]["names"])
         self.video_keys = [k for k, f in features.items() if f.get("dtype") == "video"]
         self._tracks: dict[str, VideoTrack] = {}
         self._writer: Any = None

@@ -27,16 +27,10 @@ from collections.abc import Sequence
 from typing import Any
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.sim.properties import ACTION_NAMES, BY_NAME
+from gymfg_il.sim.properties import ACTION_NAMES, task_columns
 
 OUR_KEYS = ("observation.state", "action", "next.reward", "next.done", "intervention")
 ENVIRONMENT_STATE = "observation.environment_state"
-
-
-def environment_indices(observation_names: Sequence[str]) -> list[int]:
-    """Where the task's own columns (every name that is not an aircraft state variable of the
-    catalogue) sit in the observation."""
-    return [i for i, name in enumerate(observation_names) if name not in BY_NAME]
 
 
 def dataset_features(
@@ -52,12 +46,12 @@ def dataset_features(
         }
         for view in images
     }
-    task_columns = [observation_names[i] for i in environment_indices(observation_names)]
+    own = [observation_names[i] for i in task_columns(observation_names)]
     environment = {
         ENVIRONMENT_STATE: {
             "dtype": "float32",
-            "shape": (len(task_columns),),
-            "names": task_columns,
+            "shape": (len(own),),
+            "names": own,
         }
     }
     return {
@@ -67,7 +61,7 @@ def dataset_features(
             "shape": (len(observation_names),),
             "names": list(observation_names),
         },
-        **(environment if task_columns else {}),
+        **(environment if own else {}),
         "action": {"dtype": "float32", "shape": (4,), "names": list(ACTION_NAMES)},
         "next.reward": {"dtype": "float32", "shape": (1,), "names": None},
         "next.done": {"dtype": "bool", "shape": (1,), "names": None},

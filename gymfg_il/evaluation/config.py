@@ -104,12 +104,27 @@ class EvalRun:
     written: list[Path] = field(default_factory=list)
 
 
+def _meta(path: Path) -> dict[str, Any]:
+    """A policy's config; a LeRobot checkpoint's completed with the flight, rate and
+    observation of the dataset it was trained on, when that dataset is here."""
+    meta = AgentSpec.policy(path).meta()
+    if not meta.get("lerobot"):
+        return meta
+    root = meta.get("dataset")
+    if not root or not (Path(root) / "meta" / "info.json").is_file():
+        meta["spec_note"] = f"its training dataset ({root}) is not here to say what it flew"
+        return meta
+    from gymfg_il.learning.data import dataset_flight
+
+    spec, why, found = dataset_flight(Path(root))
+    meta.update(found, spec=spec.to_dict() if spec else None, spec_note=why)
+    return meta
+
+
 def plan(cfg: EvalConfig) -> tuple[FlightSpec, dict[str, AgentSpec], list[str]]:
     """What flies (the flight, the agents by row name) and the notes on flags that changed a
     policy's own flight; a clear error for a policy that cannot fly it."""
-    from gymfg_il.policies.agent import PolicyAgent
-
-    metas = {path: AgentSpec.policy(path).meta() for path in cfg.policy}
+    metas = {path: _meta(path) for path in cfg.policy}
     flight, notes = flight_for(
         metas,
         task=cfg.task,
@@ -123,7 +138,7 @@ def plan(cfg: EvalConfig) -> tuple[FlightSpec, dict[str, AgentSpec], list[str]]:
     env = flight.make_env()
     try:
         for path in metas:  # loaded whole now: a damaged policy fails before anything flies
-            PolicyAgent.load(path).check_observation(env.observation_names)
+            AgentSpec.policy(path).make(env)
     finally:
         env.close()
     agents = {"controller": AgentSpec.controller()}

@@ -43,25 +43,8 @@ class Frames:
         return len(self.action)
 
     def flight(self) -> tuple[FlightSpec | None, str]:
-        """The solo flight every episode was flown as (a team run's aircraft on its own; the
-        longest episode time where only that differs), and why there is none when the
-        episodes disagree on more or predate flight specs."""
-        specs = self.episodes.get("gymfg/spec")
-        if not specs:
-            return None, "its episodes record no flight spec (its dataset predates them)"
-        callsigns = self.episodes.get("gymfg/callsign") or ["ego"] * len(specs)
-        found = {
-            FlightSpec.from_json(text).for_callsign(c)
-            for text, c in set(zip(specs, callsigns, strict=True))
-        }
-        longest = max(s.episode_time_s for s in found)
-        alike = {s.replace(episode_time_s=longest) for s in found}
-        if len(alike) > 1:
-            return None, (
-                f"its episodes were flown in {len(alike)} different flights (aircraft, task, "
-                "options or rate)"
-            )
-        return alike.pop(), ""
+        """The solo flight every episode was flown as (``flight_of``)."""
+        return flight_of(self.episodes)
 
     def demonstrated(self) -> Frames:
         """The frames a demonstrator flew: every frame of a demonstration, and of an episode a
@@ -95,6 +78,45 @@ class Frames:
             None if self.images is None else self.images[keep],
             self.camera,
         )
+
+
+def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
+    """The solo flight every episode (``gymfg/*`` columns) was flown as (a team run's
+    aircraft on its own; the longest episode time where only that differs), and why there is
+    none when the episodes disagree on more or predate flight specs."""
+    specs = episodes.get("gymfg/spec")
+    if not specs:
+        return None, "its episodes record no flight spec (its dataset predates them)"
+    callsigns = episodes.get("gymfg/callsign") or ["ego"] * len(specs)
+    found = {
+        FlightSpec.from_json(text).for_callsign(c)
+        for text, c in set(zip(specs, callsigns, strict=True))
+    }
+    longest = max(s.episode_time_s for s in found)
+    alike = {s.replace(episode_time_s=longest) for s in found}
+    if len(alike) > 1:
+        return None, (
+            f"its episodes were flown in {len(alike)} different flights (aircraft, task, "
+            "options or rate)"
+        )
+    return alike.pop(), ""
+
+
+def dataset_flight(root: Path) -> tuple[FlightSpec | None, str, dict[str, Any]]:
+    """The flight of the dataset at ``root`` (``flight_of``), without loading its frames;
+    also its ``fps`` and ``observation_names``."""
+    meta = lr.open_metadata(Path(root))
+    episodes: dict[str, list[Any]] = {}
+    if meta.episodes is not None:
+        for name in meta.episodes.column_names:
+            if name.startswith("gymfg/"):
+                episodes[name] = list(meta.episodes[name])
+    spec, why = flight_of(episodes)
+    found = {
+        "fps": int(meta.fps),
+        "observation_names": list(meta.features["observation.state"]["names"]),
+    }
+    return spec, why, found
 
 
 def _column(table: Any, name: str) -> np.ndarray:

@@ -24,13 +24,13 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from gymfg_il.datasets.features import environment_indices
 from gymfg_il.datasets.videos import check_views
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.evaluation.metrics import score_episode
 from gymfg_il.evaluation.trace import make_trace
 from gymfg_il.recording.session import task_description
+from gymfg_il.sim.properties import task_columns
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, episode_steps
 
 NEW_ROLLOUT = "lerobot_new_rollout"
@@ -77,7 +77,7 @@ class LeRobotFlightEnv(gym.Env):
         self.render_mode = render_mode
         self.metadata = {**type(self).metadata, "render_fps": agent_hz}
         names = self.env.observation_names
-        self._environment = environment_indices(names)
+        self._environment = task_columns(names)
         self.images = tuple(check_views(list(images)))
         self.image_size = int(image_size)
         box = self.env.observation_space

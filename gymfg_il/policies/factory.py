@@ -89,8 +89,9 @@ def read_config(path: Path) -> dict[str, Any]:
     path = Path(path)
     if not (path / CONFIG_FILE).is_file() or not (path / WEIGHTS_FILE).is_file():
         raise ConfigError(
-            f"{path} is not a policy checkpoint (needs {CONFIG_FILE} and {WEIGHTS_FILE}); "
-            "train one with `python -m gymfg_il.train bc`"
+            f"{path} is not a policy checkpoint (needs {CONFIG_FILE} and {WEIGHTS_FILE}): give "
+            "a folder `python -m gymfg_il.train bc` wrote, or a LeRobot checkpoint "
+            "(lerobot-train's output folder or its .../pretrained_model)"
         )
     try:
         data = json.loads((path / CONFIG_FILE).read_text())
@@ -99,7 +100,10 @@ def read_config(path: Path) -> dict[str, Any]:
     need = ("type", "policy", "obs_stats", "action_stats")
     missing = [k for k in need if not isinstance(data, dict) or k not in data]
     if missing:
-        raise ConfigError(f"{path / CONFIG_FILE} is not a policy config (no {missing})")
+        raise ConfigError(
+            f"{path / CONFIG_FILE} is neither our policy config (no {missing}) nor a LeRobot "
+            "policy's (no input_features): give a folder `train bc` or lerobot-train wrote"
+        )
     return data
 
 

@@ -4,6 +4,7 @@ task's physics-based controller, or a trained policy checkpoint."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -39,21 +40,28 @@ class AgentSpec:
         if self.path is None:
             return repr(self)
         from gymfg_il.policies.factory import CONFIG_FILE, WEIGHTS_FILE
+        from gymfg_il.policies.lerobot_checkpoint import find_pretrained
 
+        folder = find_pretrained(self.path) or self.path
         stamps: list[tuple[int, int] | None] = []
         for name in (CONFIG_FILE, WEIGHTS_FILE):
             try:
-                st = (self.path / name).stat()
+                st = (folder / name).stat()
                 stamps.append((st.st_mtime_ns, st.st_size))
             except OSError:
                 stamps.append(None)  # loading it will say what is missing
         return repr((self, stamps))
 
     def meta(self) -> dict[str, Any]:
-        """A policy's ``config.json``."""
+        """A policy's ``config.json`` (for a LeRobot checkpoint, what its config says of it:
+        ``policies.lerobot_checkpoint.lerobot_meta``)."""
         from gymfg_il.policies.factory import read_config
+        from gymfg_il.policies.lerobot_checkpoint import find_pretrained, lerobot_meta
 
         assert self.path is not None
+        folder = find_pretrained(self.path)
+        if folder is not None:
+            return lerobot_meta(folder)
         return read_config(self.path)
 
     def make(self, env: AircraftEnv) -> Agent:
@@ -72,8 +80,16 @@ class AgentSpec:
             human = ManualController(self.device, throttle=throttle)
             return PilotAgent(SyntheticPilot(self.device, pilot, env.dt, self.skill), human)
         from gymfg_il.policies.agent import PolicyAgent
+        from gymfg_il.policies.lerobot_checkpoint import LeRobotAgent, find_pretrained
 
         assert self.path is not None
+        folder = find_pretrained(self.path)
+        if folder is not None:
+            checkpoint = LeRobotAgent(folder)
+            checkpoint.check_observation(env.observation_names)
+            for view, size in checkpoint.camera_sizes.items():
+                checkpoint.see[view] = partial(env.camera_frame, view, size)
+            return checkpoint
         agent = PolicyAgent.load(self.path)
         agent.check_observation(env.observation_names)
         if agent.camera is not None:

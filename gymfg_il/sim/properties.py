@@ -8,6 +8,7 @@ all derived from ``CATALOGUE``. A state vector is a float64 array in catalogue o
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,6 +81,12 @@ ACTION_HIGH = np.array([1.0, 1.0, 1.0, 1.0], dtype=np.float32)
 POSITION = ("lat_deg", "lon_deg", "altitude_ft")
 ORIENTATION = ("roll_deg", "pitch_deg", "heading_deg")
 DEFAULT_OPPONENT_VIEW: tuple[str, ...] = POSITION + ORIENTATION
+
+
+def task_columns(observation_names: Sequence[str]) -> list[int]:
+    """Where a task's own columns (targets, errors, integrals, gates: every name that is not
+    a catalogue state variable) sit in its observation; a dataset's environment state."""
+    return [i for i, name in enumerate(observation_names) if name not in BY_NAME]
 
 
 def indices(names: tuple[str, ...] | list[str]) -> np.ndarray:
