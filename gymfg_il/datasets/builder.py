@@ -125,7 +125,12 @@ class DatasetBuilder:
             raise ConfigError("an episode needs at least one frame")
         if self._environment is not None and ENVIRONMENT_STATE not in columns:
             state = np.asarray(columns["observation.state"])
-            columns = {**columns, ENVIRONMENT_STATE: state[:, self._environment]}
+            given = {
+                **columns,
+                ENVIRONMENT_STATE: np.ascontiguousarray(state[:, self._environment]),
+            }
+            # in the features' order, as LeRobot's writer keeps its statistics
+            columns = {k: given[k] for k in meta.features if k in given}
         index = meta.total_episodes
         start = meta.total_frames
         frames = {

@@ -44,6 +44,8 @@ def both(tmp_path_factory):
             stock.add_frame(
                 {
                     "observation.state": ep["observation.state"][i],
+                    # no name is a catalogue variable: every column is the task's own
+                    "observation.environment_state": ep["observation.state"][i],
                     "action": ep["action"][i],
                     "next.reward": ep["next.reward"][i : i + 1],
                     "next.done": ep["next.done"][i : i + 1],
