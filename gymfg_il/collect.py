@@ -3,6 +3,7 @@
     python -m gymfg_il.collect autopilot --aircraft c172p --task altitude --episodes 20 --out DIR
     python -m gymfg_il.collect collectors/sample.toml        # a recipe
     python -m gymfg_il.collect recover DIR                   # rebuild DIR/dataset from DIR/logs
+    python -m gymfg_il.collect repair EDITED --source ORIGINAL   # after lerobot-edit-dataset
     python -m gymfg_il.collect replay DIR                    # re-fly logged episodes, compare
     python -m gymfg_il.collect dagger --policy P --out DIR   # DAgger with the controller
     python -m gymfg_il.collect manual --device keyboard --out DIR   # a person flies
@@ -49,7 +50,7 @@ def _running(p: argparse.ArgumentParser) -> None:
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
     from gymfg_il import cli
-    from gymfg_il.collectors.commands import RecoverConfig, ReplayConfig
+    from gymfg_il.collectors.commands import RecoverConfig, RepairConfig, ReplayConfig
     from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.learning.dagger import DaggerConfig
 
@@ -74,7 +75,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         EPILOG,
     )
     sub = p.add_subparsers(
-        dest="command", metavar="{autopilot,manual,dagger,recover,replay,RECIPE.toml}"
+        dest="command", metavar="{autopilot,manual,dagger,recover,repair,replay,RECIPE.toml}"
     )
     auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
     cli.add_fields(auto, CollectConfig, only=AUTOPILOT)
@@ -104,6 +105,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     cli.add_fields(dagger, DaggerConfig)
     recover = sub.add_parser("recover", help=cli.summary(RecoverConfig))
     cli.add_fields(recover, RecoverConfig)
+    repair = sub.add_parser("repair", help=cli.summary(RepairConfig))
+    cli.add_fields(repair, RepairConfig)
     replay = sub.add_parser("replay", help=cli.summary(ReplayConfig))
     cli.add_fields(replay, ReplayConfig)
     args = p.parse_args(argv)
@@ -257,6 +260,14 @@ def _recover(args: argparse.Namespace) -> int:
     return recover(cfg.dir, cfg.callsign)
 
 
+def _repair(args: argparse.Namespace) -> int:
+    from gymfg_il import cli
+    from gymfg_il.collectors.commands import RepairConfig, repair
+
+    cfg = cli.build(RepairConfig, args)
+    return repair(cfg.dir, cfg.source)
+
+
 def _replay(args: argparse.Namespace) -> int:
     from gymfg_il import cli
     from gymfg_il.collectors.commands import ReplayConfig, replay
@@ -271,6 +282,7 @@ COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "manual": _manual,
     "dagger": _dagger,
     "recover": _recover,
+    "repair": _repair,
     "replay": _replay,
 }
 

@@ -1,4 +1,4 @@
-"""The bodies of ``collect recover`` and ``collect replay`` (``gymfg_il.collect`` parses)."""
+"""The bodies of ``collect recover``, ``repair`` and ``replay`` (``gymfg_il.collect`` parses)."""
 
 from __future__ import annotations
 
@@ -27,6 +27,23 @@ class RecoverConfig:
 
     dir: Path = field(metadata={"positional": True})
     callsign: list[str] = field(default_factory=list, metadata={"repeat": True})
+
+
+@dataclass
+class RepairConfig:
+    """Write back the GymFG episode metadata (the gymfg/* columns: aircraft, task, seed,
+    source, flight spec, ...) that LeRobot's own editing (lerobot-edit-dataset delete_episodes,
+    split, merge, remove_feature) drops: each episode's is taken from the dataset it came
+    from, found by its frames.
+
+    Attributes:
+        dir: the edited dataset (meta/ inside), or a session folder (dataset/ inside).
+        source: a dataset (or session folder) the edited one was made from; repeatable (a
+            merge has several).
+    """
+
+    dir: Path = field(metadata={"positional": True})
+    source: list[Path] = field(default_factory=list, metadata={"repeat": True})
 
 
 @dataclass
@@ -123,3 +140,30 @@ def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
     report = build_from_logs(logs, folder / DATASET, callsigns=callsigns or None)
     report_build(report, folder / DATASET)
     return 1 if report.damage else 0  # the dataset holds all that could be read
+
+
+def repair(folder: Path, sources: Sequence[Path]) -> int:
+    """Restore the ``gymfg/*`` episode columns of the dataset at ``folder`` from ``sources``
+    (``datasets.provenance.restore``)."""
+    from gymfg_il.datasets import lerobot_api as lr
+    from gymfg_il.datasets.provenance import metadata_columns, restore
+
+    def dataset(path: Path) -> Path:
+        root = path / DATASET if (path / DATASET / "meta").is_dir() else path
+        if not (root / "meta" / "info.json").is_file():
+            raise ConfigError(f"no LeRobot dataset at {path} (no meta/info.json)")
+        return root
+
+    root = dataset(folder)
+    meta = lr.open_metadata(root)
+    if metadata_columns(meta):
+        print(f"dataset {root}: its episodes have their gymfg/* columns; nothing to repair")
+        return 0
+    if not sources:
+        raise ConfigError(
+            f"the episodes of {root} have lost their gymfg/* columns (LeRobot's dataset "
+            "editing drops them): give the dataset it was made from, --source ORIGINAL"
+        )
+    restored = restore(root, meta, [dataset(s) for s in sources])
+    print(f"dataset {root}: restored the gymfg/* columns of {restored} episodes")
+    return 0

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.features import check_compatible, dataset_features
+from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
@@ -80,8 +81,8 @@ def check_appendable(
     check_compatible(meta.features, wanted, str(root))
     if meta.fps != fps:
         raise ConfigError(f"the dataset at {root} is at {meta.fps} fps, not {fps}")
-    episodes = meta.episodes
-    if flight is None or episodes is None or "gymfg/spec" not in episodes.column_names:
+    episodes = metadata_columns(meta)
+    if flight is None or "gymfg/spec" not in episodes:
         return
     mine = flight.replace(episode_time_s=1.0)  # episode times may differ
     theirs = {FlightSpec.from_json(s).replace(episode_time_s=1.0) for s in episodes["gymfg/spec"]}
@@ -99,9 +100,9 @@ def already_collected(out: Path, flight: FlightSpec, source: str, noise: float) 
     root = out / DATASET
     if not (root / "meta" / "info.json").is_file():
         return set()
-    episodes = lr.open_metadata(root).episodes
+    episodes = metadata_columns(lr.open_metadata(root))
     need = ("gymfg/seed", "gymfg/spec", "gymfg/source", "gymfg/noise")
-    if episodes is None or not set(need) <= set(episodes.column_names):
+    if not set(need) <= set(episodes):
         return set()
     rows = zip(*(episodes[c] for c in need), strict=True)
     return {

@@ -23,6 +23,7 @@ from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.features import dataset_features
 from gymfg_il.datasets.health import dataset_problems
+from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views, episode_frames, image_key
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import EmptyLog, Log, LoggedEpisode, read_log
@@ -102,10 +103,9 @@ def _clean_leftovers(root: Path) -> None:
 
 
 def _present(root: Path) -> set[tuple[str, int, str]]:
-    meta = lr.open_metadata(root)
-    if meta.episodes is None or "gymfg/log" not in meta.episodes.column_names:
+    eps = metadata_columns(lr.open_metadata(root))
+    if "gymfg/log" not in eps:
         return set()
-    eps = meta.episodes
     return set(zip(eps["gymfg/log"], eps["gymfg/log_episode"], eps["gymfg/callsign"], strict=True))
 
 

@@ -271,6 +271,12 @@ def _train(
             val_batches = TensorBatches(val, 1024, device, sequence, cfg.seed, chunks, stack, pool)
         except ConfigError as err:  # held-out frames too short for a window: train on
             log.warning("no validation loss: the held-out episodes are too short (%s)", err)
+    image_size = None if frames.images is None else int(frames.images.shape[1])
+    # the batches hold the pooled frames: the full-size ones of the split go (vision DAgger
+    # on 60 episodes ran out of 24 GiB with them kept)
+    for part in (train, val):
+        if part is not None and part is not frames:  # frames may be the caller's
+            part.images = None
     opt = torch.optim.AdamW(policy.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     epochs = epochs_for(cfg, frames)
     steps = epochs * len(batches)
@@ -304,8 +310,8 @@ def _train(
         "dynamic": flight.dynamic if flight else False,
         "aircraft": flight.aircraft if flight else None,
         "observation_names": frames.observation_names,
-        "camera": {"view": cfg.camera, "size": int(frames.images.shape[1])}
-        if cfg.policy == "vision" and frames.images is not None
+        "camera": {"view": cfg.camera, "size": image_size}
+        if cfg.policy == "vision" and image_size is not None
         else None,
         "action_names": frames.action_names,
         "fps": frames.fps,

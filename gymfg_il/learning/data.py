@@ -16,6 +16,7 @@ import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.health import dataset_problems
+from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.videos import decode_camera, image_key
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, join_problems
@@ -86,7 +87,10 @@ def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
     none when the episodes disagree on more or predate flight specs."""
     specs = episodes.get("gymfg/spec")
     if not specs:
-        return None, "its episodes record no flight spec (its dataset predates them)"
+        return None, (
+            "its episodes record no flight spec (its dataset predates them, or LeRobot's "
+            "editing dropped them: `python -m gymfg_il.collect repair DIR --source ORIGINAL`)"
+        )
     callsigns = episodes.get("gymfg/callsign") or ["ego"] * len(specs)
     found = {
         FlightSpec.from_json(text).for_callsign(c)
@@ -106,12 +110,7 @@ def dataset_flight(root: Path) -> tuple[FlightSpec | None, str, dict[str, Any]]:
     """The flight of the dataset at ``root`` (``flight_of``), without loading its frames;
     also its ``fps`` and ``observation_names``."""
     meta = lr.open_metadata(Path(root))
-    episodes: dict[str, list[Any]] = {}
-    if meta.episodes is not None:
-        for name in meta.episodes.column_names:
-            if name.startswith("gymfg/"):
-                episodes[name] = list(meta.episodes[name])
-    spec, why = flight_of(episodes)
+    spec, why = flight_of(metadata_columns(meta))
     found = {
         "fps": int(meta.fps),
         "observation_names": list(meta.features["observation.state"]["names"]),
@@ -156,11 +155,10 @@ def load_frames(root: Path, camera: str | None = None) -> Frames:
             raise ConfigError(f"the dataset at {root} has no {key!r} feature")
     table = ds.hf_dataset.data.table
     stats = ds.meta.stats
-    episodes: dict[str, list[Any]] = {}
+    episodes = metadata_columns(ds.meta)
     if ds.meta.episodes is not None:
-        for name in ds.meta.episodes.column_names:
-            if name.startswith("gymfg/") or name in ("episode_index", "length"):
-                episodes[name] = list(ds.meta.episodes[name])
+        for name in ("episode_index", "length"):
+            episodes[name] = list(ds.meta.episodes[name])
     return Frames(
         obs=_column(table, "observation.state").astype(np.float32),
         action=_column(table, "action").astype(np.float32),

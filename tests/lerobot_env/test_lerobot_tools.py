@@ -160,3 +160,30 @@ def test_a_checkpoint_without_its_dataset_needs_task_and_aircraft(act, tmp_path,
     assert "--task and --aircraft" in capsys.readouterr().err
     argv = ["--policy", str(moved), "--task", "roll", "--aircraft", "c172p", "--episodes", "1"]
     assert evaluate.main([*argv, "--episode-time", "3", "--no-progress"]) == 0
+
+
+def test_collect_repair_restores_what_lerobot_edit_dataset_dropped(session, tmp_path, capsys):
+    from gymfg_il.datasets import lerobot_api as lr
+
+    edited = tmp_path / "edited"
+    _run(
+        [
+            str(BIN / "lerobot-edit-dataset"),
+            "--repo_id=gymfg/roll-c172p",
+            f"--root={session / 'dataset'}",
+            "--new_repo_id=gymfg/roll-edited",
+            f"--new_root={edited}",
+            "--operation.type=delete_episodes",
+            "--operation.episode_indices=[1]",
+        ],
+        tmp_path,
+    )
+    columns = lr.open_metadata(edited).episodes.column_names
+    assert not [c for c in columns if c.startswith("gymfg/")]  # what LeRobot's edit does
+    assert collect.main(["repair", str(edited)]) == 2  # which source: a clear error
+    assert "--source" in capsys.readouterr().err
+    assert collect.main(["repair", str(edited), "--source", str(session)]) == 0
+    restored = lr.open_metadata(edited).episodes
+    assert list(restored["gymfg/seed"]) == [1000, 1002]
+    assert list(restored["gymfg/log_episode"]) == [0, 2]
+    assert list(restored["gymfg/task"]) == ["roll", "roll"]
