@@ -133,7 +133,7 @@ def write_report(run: Path, policy: Path, rows: list[dict[str, object]], seconds
         f"# GymFG-IL run {run.name}",
         "",
         f"Behaviour cloning ({meta['type']}) on `{meta['dataset']}` "
-        f"({meta['train']['frames']} training frames, {meta['train']['epochs']} epochs), "
+        f"({meta['train']['train_frames']} training frames, {meta['train']['epochs']} epochs), "
         f"evaluated on {rows[0]['episodes']} held-out seeds of the {rows[0]['task']} task on "
         f"{rows[0]['aircraft']} at {rows[0]['agent_hz']} Hz.",
         "",

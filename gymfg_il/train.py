@@ -50,7 +50,7 @@ def _bc(cfg: object, show_progress: bool) -> int:
     result = train_bc(cfg, on_epoch, frames)
     bar.close()
     print(
-        f"trained {result.meta['name']} on {result.meta['train']['frames']} frames "
+        f"trained {result.meta['name']} on {result.meta['train']['train_frames']} frames "
         f"({result.frames / result.seconds:,.0f} frames/s): loss {result.train_loss[0]:.4f} "
         f"-> {result.train_loss[-1]:.4f}, validation {result.val_loss[-1]:.4f}"
     )

@@ -94,6 +94,8 @@ class TrainConfig:
             problems.append(
                 f"history={self.history}, chunk={self.chunk} and frames={self.frames} must be >= 1"
             )
+        if self.frames > 16:  # each is a full camera frame per training sample in memory
+            problems.append(f"frames={self.frames}: a vision policy sees 1 to 16 camera frames")
         if self.threads is not None and self.threads < 0:
             problems.append(f"threads={self.threads}: want 0 (torch decides) or more")
         if (self.epochs is not None and self.epochs < 1) or self.batch_size < 1:
@@ -320,7 +322,7 @@ def _train(
             **{k: (str(v) if isinstance(v, Path) else v) for k, v in asdict(cfg).items()},
             "device": device,
             "epochs": epochs,
-            "frames": len(train),
+            "train_frames": len(train),  # not "frames": that is the camera stack
             "val_frames": len(val) if val else 0,
             "train_loss": train_loss,
             "val_loss": val_loss,

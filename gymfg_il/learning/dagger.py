@@ -33,6 +33,8 @@ class DaggerConfig:
         seed: seed of the first episode (the rounds take the seeds that follow).
         epochs: training epochs per round (default: the policy's own).
         workers: worker processes flying episodes.
+        ray: fly the episodes on a Ray cluster instead: auto, local or HOST:PORT (results
+            identical to one worker).
     """
 
     policy: Path
@@ -43,6 +45,7 @@ class DaggerConfig:
     seed: int = 2000
     epochs: int | None = None
     workers: int = 1
+    ray: str | None = None
 
     def __post_init__(self) -> None:
         self.policy, self.out = Path(self.policy), Path(self.out)
@@ -63,7 +66,7 @@ class DaggerConfig:
         overrides = {"epochs": self.epochs} if self.epochs else {}
         return run_dagger(
             self.policy, self.out, self.iterations, self.episodes, self.seed, self.workers,
-            overrides, on_iteration,
+            overrides, on_iteration, self.ray,
         )  # fmt: skip
 
 
@@ -86,6 +89,7 @@ def run_dagger(
     workers: int = 1,
     train_overrides: dict[str, Any] | None = None,
     on_iteration: Callable[[DaggerIteration], None] | None = None,
+    ray: str | None = None,
 ) -> list[DaggerIteration]:
     """``iterations`` rounds of fly / label / aggregate / retrain, starting from ``policy``."""
     from gymfg_il.datasets.from_logs import build_from_logs
@@ -115,11 +119,13 @@ def run_dagger(
     size = int(root_meta.features[cameras[0]]["shape"][0]) if cameras else 128
     known = {f.name for f in fields(TrainConfig)}
     train_args = {k: v for k, v in meta.get("train", {}).items() if k in known}
+    if meta.get("type") == "vision":  # checkpoints before 2026-11-24 recorded the frame
+        train_args["frames"] = meta["policy"]["frames"]  # count under "frames" (32,400)
     train_args.update(train_overrides or {})
     current = Path(policy)
     history = []
     # one pool for every round, forked before training starts threads in this process
-    with Workers(min(workers, episodes)) as pool:
+    with Workers(min(workers, episodes), ray=ray) as pool:
         for it in range(1, iterations + 1):
             seeds = range(seed + (it - 1) * episodes, seed + it * episodes)
             session = record_session(
