@@ -45,6 +45,14 @@ def _running(p: argparse.ArgumentParser) -> None:
         help="worker processes flying episodes; the log and dataset are identical to one "
         "worker's (default: 1)",
     )
+    p.add_argument(
+        "--ray",
+        metavar="ADDRESS",
+        default=None,
+        help="fly the episodes as tasks on a Ray cluster: auto (the one this machine is in), "
+        "local (start one in this process) or HOST:PORT; the log and dataset are written "
+        "here and are identical to one worker's (pip install -e '.[ray]')",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -136,8 +144,10 @@ def _autopilot(args: argparse.Namespace) -> int:
         options = {k: v for k, v in vars(args).items() if k in RECIPE}
         cfg = CollectConfig.from_recipe(args.recipe, **options)
         if cfg.kind == "manual":
-            if "noise" in options or args.workers != 1:
-                raise ConfigError("--noise and --workers apply to autopilot recipes, not manual")
+            if "noise" in options or args.workers != 1 or args.ray:
+                raise ConfigError(
+                    "--noise, --workers and --ray apply to autopilot recipes, not manual"
+                )
             return _fly_by_hand(cfg, not args.no_progress)
         manual_only = sorted(set(options) & (set(MANUAL) - set(AUTOPILOT)))
         if manual_only:
@@ -160,7 +170,7 @@ def _autopilot(args: argparse.Namespace) -> int:
 
         return tick
 
-    result, report = collect_autopilot(cfg, args.workers, progress)
+    result, report = collect_autopilot(cfg, args.workers, progress, ray=args.ray)
     if result.log is None:
         print(f"nothing to fly: the dataset at {cfg.out / 'dataset'} holds these episodes")
     else:

@@ -6,6 +6,12 @@ from picklable specs (``FlightSpec``, ``AgentSpec``) and keep it between episode
 
 ``map_seeds(..., workers=2)`` starts a pool for the call; ``with Workers(2) as workers:``
 keeps one for several calls (evaluating several agents, rounds of episodes).
+
+``Workers(n, ray=ADDRESS)`` runs the episodes as Ray tasks instead, on every node of a Ray
+cluster (``auto``: the cluster this machine belongs to, ``local``: one started in-process, or
+``HOST:PORT``). Ray reuses its worker processes, so the kept env stays warm there too; a task
+whose worker or node dies is run again elsewhere (``RAY_RETRIES``), and results still come
+back in seed order to this process, which writes every log and dataset.
 """
 
 from __future__ import annotations
@@ -78,6 +84,73 @@ def _call[T](job: tuple[Callable[..., T], tuple[Any, ...]]) -> T:
     return fn(*args)
 
 
+RAY_RETRIES = 3  # runs of an episode whose worker or node died, before the run fails
+
+
+def _seed_task[T](fn: Callable[..., T], args: tuple[Any, ...], seed: int) -> T:
+    return fn(*args, seed)
+
+
+class _RayTasks:
+    """Episodes as Ray tasks: connected at start, disconnected (a local cluster stopped) at
+    close."""
+
+    def __init__(self, address: str) -> None:
+        import os
+        from pathlib import Path
+
+        # Ray 2.60's `ray start --head` turns on token authentication and keeps the token in
+        # ~/.ray/auth_token; a driver must say it uses it before Ray is imported
+        if address != "local" and (Path.home() / ".ray" / "auth_token").is_file():
+            os.environ.setdefault("RAY_AUTH_MODE", "token")
+        try:
+            import ray
+        except ImportError:
+            raise ConfigError(
+                f"--ray {address}: Ray is not installed; pip install -e '.[ray]'"
+            ) from None
+        self.ray = ray
+        self.started = not ray.is_initialized()
+        if self.started:
+            try:
+                if address == "local":
+                    ray.init(include_dashboard=False, log_to_driver=False)
+                else:
+                    ray.init(address=address, log_to_driver=False)
+            except (ConnectionError, ValueError, RuntimeError) as err:
+                first = str(err).strip().splitlines()[0] if str(err).strip() else ""
+                raise ConfigError(
+                    f"--ray {address}: no Ray cluster there ({first}); start one with `ray "
+                    "start --head`, or give --ray local to start one in this process"
+                ) from None
+        self.task: Any = ray.remote(num_cpus=1, max_retries=RAY_RETRIES)(_seed_task)
+        self.slots = max(1, int(ray.cluster_resources().get("CPU", 1)))
+
+    def imap[T](self, fn: Callable[..., T], args: tuple[Any, ...], seeds: list[int]) -> Iterator[T]:
+        """``fn(*args, seed)`` per seed, in seed order; a few tasks per CPU in flight, so a
+        long run holds no more than that in the cluster's object store."""
+        from collections import deque
+
+        ray = self.ray
+        shared = ray.put(args)
+        todo = iter(seeds)
+        flying: deque[Any] = deque()
+        for seed in todo:
+            flying.append(self.task.remote(fn, shared, seed))
+            if len(flying) >= 4 * self.slots:
+                break
+        while flying:
+            result = ray.get(flying.popleft())
+            following = next(todo, None)
+            if following is not None:
+                flying.append(self.task.remote(fn, shared, following))
+            yield result
+
+    def close(self) -> None:
+        if self.started and self.ray.is_initialized():
+            self.ray.shutdown()
+
+
 class Workers:
     """Worker processes kept for several ``map_seeds`` calls; ``close()`` (or the end of a
     ``with`` block) stops them.
@@ -90,15 +163,21 @@ class Workers:
     its work runs in this one.
     """
 
-    def __init__(self, n: int) -> None:
+    def __init__(self, n: int, ray: str | None = None) -> None:
         self.n = _count(n)
         self.closed = False
+        self._ray = _RayTasks(ray) if ray else None
+        if self._ray is not None:
+            self.n = max(2, self._ray.slots)  # the cluster's CPUs, never this process alone
         ctx = mp.get_context(_start_method())
-        self._pool: Any = ctx.Pool(n, initializer=_worker_init) if n > 1 else None
+        self._pool: Any = ctx.Pool(n, initializer=_worker_init) if n > 1 and not ray else None
 
     def _imap[T](
         self, fn: Callable[..., T], args: tuple[Any, ...], seeds: list[int]
     ) -> Iterator[T]:
+        if self._ray is not None:
+            yield from self._ray.imap(fn, args, seeds)
+            return
         jobs = [(fn, (*args, seed)) for seed in seeds]
         # one episode per task: a task costs ~0.1 ms to send, an episode ~100 ms to fly, and
         # the last worker to finish then waits at most one episode
@@ -110,6 +189,9 @@ class Workers:
 
     def close(self) -> None:
         self.closed = True
+        if self._ray is not None:
+            self._ray.close()
+            self._ray = None
         if self._pool is not None:
             self._pool.terminate()
             self._pool.join()

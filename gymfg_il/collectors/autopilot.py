@@ -64,14 +64,16 @@ def collect_autopilot(
     cfg: CollectConfig,
     workers: int = 1,
     progress: Callable[[int], Callable[[int, float], None]] | None = None,
+    ray: str | None = None,
 ) -> tuple[SessionResult, BuildReport | None]:
     """Record ``cfg``'s episodes (those the dataset lacks, ``seeds_to_fly``) on ``workers``
-    processes, then bring ``cfg.out/dataset`` up to date with every log of the session.
+    processes (or on the Ray cluster at ``ray``: ``workers.Workers``), then bring
+    ``cfg.out/dataset`` up to date with every log of the session.
 
     ``progress(total)`` is called once the workers run (a bar made before would start a
     thread, and the workers could then not be forked) and returns the per-episode callback."""
     seeds = seeds_to_fly(cfg)
-    with Workers(max(1, min(workers, len(seeds)))) as pool:
+    with Workers(max(1, min(workers, len(seeds))), ray=ray if seeds else None) as pool:
         tick = progress(len(seeds)) if progress and seeds else None
         result = record_autopilot(cfg, workers=pool, progress=tick, seeds=seeds)
     logs = sorted((cfg.out / LOGS).glob("*.mcap"))

@@ -43,6 +43,8 @@ class EvalConfig:
             policy is not flown at another rate than it was trained at).
         workers: worker processes flying episodes in parallel; results are identical to one
             worker.
+        ray: fly the episodes as tasks on a Ray cluster instead: auto (the one this machine
+            is in), local (start one here) or HOST:PORT; results identical to one worker.
         json: write the rows as JSON to this file.
         plots: write Figure-1 plots (one PNG per agent) to this folder.
         plot_episodes: episodes (rows) per plot.
@@ -65,6 +67,7 @@ class EvalConfig:
     episode_time_s: float | None = field(default=None, metadata={"flag": "--episode-time"})
     agent_hz: int | None = None
     workers: int = 1
+    ray: str | None = None
     json: Path | None = None
     plots: Path | None = None
     plot_episodes: int = 4
@@ -161,7 +164,7 @@ def run_eval(
     thread, and workers then could not be forked) and returns the per-episode callback."""
     flight, agents, notes = plan(cfg)
     seeds = cfg.seeds
-    with Workers(min(cfg.workers, len(seeds))) as pool:
+    with Workers(min(cfg.workers, len(seeds)), ray=cfg.ray) as pool:
         tick = progress(len(agents) * len(seeds)) if progress else None
         rows, traces = evaluate(flight, agents, seeds, pool, tick)
     run = EvalRun(flight, rows, traces, notes)
