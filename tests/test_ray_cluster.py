@@ -37,7 +37,7 @@ def _free_port() -> int:
 def cluster(tmp_path_factory):
     port = _free_port()
     address = f"127.0.0.1:{port}"
-    env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0"}
+    env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0", "RAY_worker_niceness": "0"}
     common = ["--num-cpus=1", "--disable-usage-stats"]
     head = [RAY, "start", "--head", f"--port={port}", "--include-dashboard=false", *common]
     subprocess.run(head, env=env, check=True, capture_output=True, timeout=120)
