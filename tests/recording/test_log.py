@@ -86,3 +86,19 @@ def test_writer_never_overwrites_and_reader_rejects_garbage(tmp_path, session):
         read_log(junk)
     with pytest.raises(LogError, match="no trajectory log"):
         read_log(tmp_path / "missing.mcap")
+
+
+def test_every_chunk_is_message_indexed_as_foxglove_reads_it(session):
+    """Foxglove's indexed reader needs each chunk index's message indexes; read every message
+    through them (the summary's chunk indexes, then each chunk's message index records)."""
+    from mcap.reader import SeekingReader
+
+    path = session.log
+    with open(path, "rb") as f:
+        reader = SeekingReader(f)
+        summary = reader.get_summary()
+        assert summary is not None and summary.chunk_indexes
+        assert all(ci.message_index_offsets for ci in summary.chunk_indexes)
+        assert not summary.attachment_indexes
+        indexed = sum(summary.statistics.channel_message_counts.values())
+        assert indexed == sum(1 for _ in reader.iter_messages())
