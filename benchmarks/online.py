@@ -1,10 +1,13 @@
 """The online lockstep: simulation steps/s of client processes (one c172p each, flown by its
 autopilot at 10 Hz) in lockstep with a real server on loopback.
 
-Two teams run in alternating rounds beside clients that sleep on every reply
-(``spin_us=0``), I/O threads at the default scheduling policy, clients pinned to a CPU each,
-and two teams that only report without simulating (the messaging's own ceiling); 8 and 16
-teams are one run each.
+Each round measures what the machine gives (2 and 16 teams that only report without
+simulating: the messaging alone; one aircraft's physics and autopilot in one process) beside
+2 and 16 simulating teams, and rates each against its bound: for 2 teams
+1/(1/messaging + 1/physics), for 16 the smaller of the 16-team messaging rate and
+cores x physics / 16. Two teams also run beside clients that sleep on every reply
+(``spin_us=0``), I/O threads at the default scheduling policy and clients pinned to a CPU each.
+8 teams are one run.
 
     python -m benchmarks.online --client ADDRESS TEAM STEPS CPU SPIN_US BATCH_IO
     python -m benchmarks.online --bare-client ADDRESS TEAM STEPS
@@ -55,6 +58,26 @@ def client(
         (obs,), *_ = env.step(pilot.act(obs))
     print(f"RATE {steps / (time.perf_counter() - t0)}", flush=True)
     env.close()
+
+
+def physics(steps: int) -> float:
+    """One aircraft's physics rate: the clients' team (one c172p, its autopilot, 10 Hz) flown
+    in this process by ``OfflineEnv``, no messaging; simulation steps/s."""
+    from gymfg_il import Team
+    from gymfg_il.aircraft import c172p
+    from gymfg_il.controllers.autopilot import controller_for
+    from gymfg_il.envs import OfflineEnv
+    from gymfg_il.tasks import LevelFlightTask
+
+    team = Team("solo", [(c172p("solo-1"), LevelFlightTask)], episode_time_s=steps / 10 + 10)
+    env = OfflineEnv()
+    (obs,), _ = env.reset(team, seed=0)
+    assert env.world is not None
+    pilot = controller_for(env.world.slots[0].task, "c172p", env.dt, 0.75)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        (obs,), *_ = env.step(pilot.act(obs))
+    return steps / (time.perf_counter() - t0)
 
 
 def bare_client(address: str, name: str, steps: int) -> None:
@@ -143,43 +166,76 @@ def online(
         server.wait(10)
 
 
+DEFAULT = "default (clients poll up to 1 ms; I/O threads batched)"
+
+
 def rows(quick: bool) -> list[Row]:
+    """Each online rate beside what the machine gives in the same round: the messaging alone
+    (clients that report without simulating) and one aircraft's physics alone."""
     steps = 300 if quick else 2000
-    bare = online(2, 300 if quick else 3000, bare=True)
     sides = {
         "clients that sleep on every reply (spin_us=0)": {"spin_us": 0.0},
         "ZeroMQ I/O threads at the default policy (batch_io off)": {"batch_io": False},
         "each client on its own CPU (OnlineEnv(cpu=i))": {"pinned": True},
-        "default (clients poll up to 1 ms; I/O threads batched)": {},
+        DEFAULT: {},
     }
     runs: dict[str, list[float]] = {side: [] for side in sides}
+    bound2, bound16, ratio2, ratio16 = [], [], [], []
+    rates16, bare16s, physics_rates = [], [], []
+    cores = len(os.sched_getaffinity(0))
     for _ in range(1 if quick else 3):  # alternating rounds: a slow spell hits all sides
+        bare2 = online(2, 3 * steps, bare=True)
+        solo = physics(steps)
         for side, options in sides.items():
             runs[side].append(online(2, steps, **options))  # type: ignore[arg-type]
-    detail = [f"2 teams, messaging alone (no simulation) {bare:9,.0f} steps/s (ceiling)"]
-    detail += [
+        bound2.append(1 / (1 / bare2 + 1 / solo))
+        ratio2.append(runs[DEFAULT][-1] / bound2[-1])
+        bare16 = online(16, steps // 2, bare=True)
+        rate16 = online(16, steps // 2)
+        bound16.append(min(bare16, cores * solo / 16))
+        ratio16.append(rate16 / bound16[-1])
+        rates16.append(rate16)
+        bare16s.append(bare16)
+        physics_rates.append(solo)
+    default = runs[DEFAULT]
+    physics_line = f"one c172p's physics and autopilot alone {np.median(physics_rates):9,.0f} steps/s"
+    detail2 = [physics_line, f"2 teams, bound 1/(1/messaging + 1/physics) {np.median(bound2):7,.0f}"]
+    detail2 += [
         f"2 teams, {side}: best {max(r):7,.0f}, median {np.median(r):7,.0f} steps/s"
         for side, r in runs.items()
     ]
-    sleeping, unbatched, pinned, default = runs.values()
-    out = [
-        Row("online_2_teams_pinned_steps_per_s", max(pinned), "steps/s"),
+    detail16 = [
+        f"16 teams, messaging alone {np.median(bare16s):7,.0f}; {cores} cores x physics / 16 "
+        f"{cores * np.median(physics_rates) / 16:7,.0f}; simulated {np.median(rates16):7,.0f}"
+        " steps/s (medians)",
+        f"per-round ratios {', '.join(f'{x:.2f}' for x in ratio16)}",
+    ]
+    sleeping, unbatched, pinned, _ = runs.values()
+    return [
         Row(
-            "online_2_teams_steps_per_s",
-            max(default),
-            "steps/s",
-            2000,
-            detail=detail,
+            "online_2_teams_vs_bound",
+            float(np.median(ratio2)),
+            "ratio",
+            0.85,
+            detail=detail2 + [f"per-round ratios {', '.join(f'{x:.2f}' for x in ratio2)}"],
             extra={
-                "median": float(np.median(default)),
+                "steps_per_s": float(np.median(default)),
+                "bound": float(np.median(bound2)),
                 "sleeping_clients": max(sleeping),
                 "io_threads_default_policy": max(unbatched),
+                "pinned": max(pinned),
             },
         ),
+        Row(
+            "online_16_teams_vs_bound",
+            float(np.median(ratio16)),
+            "ratio",
+            0.6,
+            detail=detail16,
+            extra={"steps_per_s": float(np.median(rates16)), "bound": float(np.median(bound16))},
+        ),
+        Row("online_8_teams_steps_per_s", online(8, steps // 2), "steps/s"),
     ]
-    for teams in (8, 16):
-        out.append(Row(f"online_{teams}_teams_steps_per_s", online(teams, steps), "steps/s"))
-    return out
 
 
 def main(argv: list[str] | None = None) -> int:

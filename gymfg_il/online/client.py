@@ -286,8 +286,11 @@ class OnlineEnv:
         world.step_physics(team_controls(team_actions, team.callsigns))
         terminated_now = all(s.terminated for s in world.slots)
         self._send({"type": "report", "states": self._states(), "done": world.truncated})
-        if self._batch_io:
-            os.sched_yield()  # the batched I/O thread, if it shares this CPU, sends it now
+        if self._batch_io and self._wait_s < self._spin_s:
+            # the batched I/O thread, if it shares this CPU, sends it now; not when replies
+            # are slow to come (many teams sharing few CPUs): the yield then hands the CPU
+            # to another team and costs this one a context switch (16 teams on 2 cores: ~7%)
+            os.sched_yield()
         # Rewards and observations need the other teams only when a reward targets them:
         # otherwise they are computed while the server gathers the other reports.
         early = not world.external
