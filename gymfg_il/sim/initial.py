@@ -35,7 +35,9 @@ def ecef_ft(latitude_deg: float, longitude_deg: float, altitude_ft: float) -> tu
 
 @dataclass(frozen=True, slots=True)
 class InitialConditions:
-    """An aircraft's state at the start of an episode: straight flight with a level path.
+    """An aircraft's state at the start of an episode: straight flight with a level path,
+    trimmed on request (the pitch and the controls that hold it, found by JSBSim's trim; see
+    ``gymfg_il.sim.trim``).
 
     Attributes:
         latitude_deg: geodetic latitude.
@@ -46,6 +48,10 @@ class InitialConditions:
         roll_deg: initial bank angle.
         pitch_deg: initial pitch angle.
         terrain_elevation_ft: ground elevation under the aircraft.
+        trimmed: start in trimmed straight, level flight (pitch, pitch/roll/yaw trim and
+            throttle from JSBSim's trim at this altitude and airspeed). ``False`` (for now
+            the default) starts with the given roll and pitch, zero trims and the caller's
+            throttle: an untrimmed or unusual start (upset recovery, say).
     """
 
     latitude_deg: float = 37.6189
@@ -56,10 +62,15 @@ class InitialConditions:
     roll_deg: float = 0.0
     pitch_deg: float = 0.0
     terrain_elevation_ft: float = 0.0
+    trimmed: bool = False
 
     def __post_init__(self) -> None:
         problems = []
+        if not isinstance(self.trimmed, bool):
+            problems.append(f"trimmed={self.trimmed!r} must be True or False")
         for name in self.__dataclass_fields__:
+            if name == "trimmed":
+                continue
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value):
                 problems.append(f"{name}={value!r} must be a finite number")
@@ -73,6 +84,12 @@ class InitialConditions:
             problems.append(
                 f"altitude_ft={self.altitude_ft} must be above terrain_elevation_ft="
                 f"{self.terrain_elevation_ft}"
+            )
+        if self.trimmed and (self.roll_deg or self.pitch_deg):
+            problems.append(
+                f"roll_deg={self.roll_deg}, pitch_deg={self.pitch_deg}: a trimmed start is "
+                "straight and level (its pitch comes from the trim); give trimmed=False to "
+                "start banked or pitched"
             )
         if problems:
             raise ConfigError("InitialConditions: " + "; ".join(problems))

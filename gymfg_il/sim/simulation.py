@@ -7,6 +7,7 @@ time and plain Python floats, so an agent step costs little beyond the physics i
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import tempfile
@@ -19,6 +20,7 @@ from gymfg_il.aircraft import jsbsim_root, resolve_model
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import CATALOGUE, StateVar
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
+from gymfg_il.sim.trim import Trim, trim_for
 from gymfg_il.sim.weather import Air
 
 CALM = Air()
@@ -90,6 +92,10 @@ class Simulation:
         self._retracts = any(pm.hasNode(f"gear/unit[{i}]/pos-norm") for i in range(units))
         self._run = fdm.run
         self._substep_range = range(self.substeps)
+        self._set_trims = [
+            node(f"fcs/{axis}-trim-cmd-norm").set_double_value for axis in ("pitch", "roll", "yaw")
+        ]
+        self.trim: Trim | None = None  # the last reset's trim (None: an untrimmed start)
         self.resets = 0
         if self._retracts:
             self._retract_gear()
@@ -103,8 +109,16 @@ class Simulation:
         self, ic: InitialConditions, throttle: float = 0.0, air: Air | None = None
     ) -> np.ndarray:
         """Put the aircraft in ``ic`` with engines running, in ``air`` (calm by default);
-        return the first state vector."""
+        return the first state vector. A trimmed ``ic`` (``trimmed=True``) starts at the trim's
+        pitch, with its pitch, roll and yaw trim set and its throttle instead of
+        ``throttle``; ``self.trim`` then holds it."""
         air = air or CALM
+        trim = None
+        if ic.trimmed:
+            trim = trim_for(self.model, ic.altitude_ft, ic.airspeed_kts, self.sim_hz)
+            ic = dataclasses.replace(ic, pitch_deg=trim.pitch_deg, trimmed=False)
+            throttle = trim.throttle
+        self.trim = trim
         xml = ic.to_xml(air.wind).replace("</initialize>", " <running>-1</running>\n</initialize>")
         fdm = self.fdm
         # JSBSim reads initial conditions only from a file. It lives just for the load, so
@@ -123,6 +137,10 @@ class Simulation:
         if self._has_gear:
             fdm["gear/gear-cmd-norm"] = 0.0
         fdm.reset_to_initial_conditions(0)
+        # after the reset, which zeroes JSBSim's trim commands
+        trims = (trim.elevator, trim.aileron, trim.rudder) if trim else (0.0, 0.0, 0.0)
+        for set_trim, value in zip(self._set_trims, trims, strict=True):
+            set_trim(value)
         self.resets += 1
         return self.read()
 
@@ -133,7 +151,7 @@ class Simulation:
         start its first episode with the gear down and later ones with it up. Stowing it once
         at build time makes every episode start alike.
         """
-        self.reset(InitialConditions(altitude_ft=30000.0, airspeed_kts=250.0))
+        self.reset(InitialConditions(altitude_ft=30000.0, airspeed_kts=250.0, trimmed=False))
         for _ in range(60 * self.sim_hz):
             if self.fdm["gear/gear-pos-norm"] <= 0.0:
                 break
