@@ -198,8 +198,13 @@ def rows(quick: bool) -> list[Row]:
         bare16s.append(bare16)
         physics_rates.append(solo)
     default = runs[DEFAULT]
-    physics_line = f"one c172p's physics and autopilot alone {np.median(physics_rates):9,.0f} steps/s"
-    detail2 = [physics_line, f"2 teams, bound 1/(1/messaging + 1/physics) {np.median(bound2):7,.0f}"]
+    physics_line = (
+        f"one c172p's physics and autopilot alone {np.median(physics_rates):9,.0f} steps/s"
+    )
+    detail2 = [
+        physics_line,
+        f"2 teams, bound 1/(1/messaging + 1/physics) {np.median(bound2):7,.0f}",
+    ]
     detail2 += [
         f"2 teams, {side}: best {max(r):7,.0f}, median {np.median(r):7,.0f} steps/s"
         for side, r in runs.items()
@@ -217,7 +222,7 @@ def rows(quick: bool) -> list[Row]:
             float(np.median(ratio2)),
             "ratio",
             0.85,
-            detail=detail2 + [f"per-round ratios {', '.join(f'{x:.2f}' for x in ratio2)}"],
+            detail=[*detail2, f"per-round ratios {', '.join(f'{x:.2f}' for x in ratio2)}"],
             extra={
                 "steps_per_s": float(np.median(default)),
                 "bound": float(np.median(bound2)),
