@@ -16,9 +16,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
+
+if TYPE_CHECKING:
+    from gymfg_il.sim.simulation import Simulation
 
 ALTITUDE_STEP_FT = 1000.0
 AIRSPEED_STEP_KTS = 10.0
@@ -50,8 +54,10 @@ class Trim:
         return (self.pitch_deg, self.elevator, self.aileron, self.rudder, self.throttle)
 
 
-_GRID: dict[tuple[str, int, float, float], Trim] = {}
-_TRIMMERS: dict[tuple[str, int], object] = {}
+# a point JSBSim could not trim is remembered as its error: near the envelope's edge every
+# reset would otherwise try it again (~4 ms and a JSBSim message each time)
+_GRID: dict[tuple[str, int, float, float], Trim | ConfigError] = {}
+_TRIMMERS: dict[tuple[str, int], Simulation] = {}
 
 
 def _trim_point(model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float) -> Trim:
@@ -63,7 +69,6 @@ def _trim_point(model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float
     sim = _TRIMMERS.get((model, sim_hz))
     if sim is None:
         sim = _TRIMMERS[(model, sim_hz)] = Simulation(model, sim_hz)
-    assert isinstance(sim, Simulation)
     ic = InitialConditions(altitude_ft=altitude_ft, airspeed_kts=airspeed_kts, trimmed=False)
     sim.reset(ic, throttle=0.5)
     fdm = sim.fdm
@@ -88,7 +93,13 @@ def _grid(model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float) -> T
     key = (model, sim_hz, altitude_ft, airspeed_kts)
     found = _GRID.get(key)
     if found is None:
-        found = _GRID[key] = _trim_point(model, sim_hz, altitude_ft, airspeed_kts)
+        try:
+            found = _trim_point(model, sim_hz, altitude_ft, airspeed_kts)
+        except ConfigError as err:
+            found = err
+        _GRID[key] = found
+    if isinstance(found, ConfigError):
+        raise ConfigError(str(found)) from None  # a new one: no traceback piling up
     return found
 
 
