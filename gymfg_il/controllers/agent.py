@@ -16,7 +16,9 @@ class Agent(Protocol):
 
     ``reset`` is called at the start of each episode with a seed derived from the
     environment's, so a stochastic agent is reproducible too. ``opponent_states`` holds what
-    the aircraft may see of other teams (one row per aircraft), or is empty.
+    the aircraft may see of other teams (one row per aircraft), or is empty. An agent may also
+    have ``start_from(action)``: the rollout calls it after ``reset`` with the controls the
+    aircraft starts with (a trimmed start's throttle), so controllers start from the trim.
     """
 
     def reset(self, seed: int | None = None) -> None: ...

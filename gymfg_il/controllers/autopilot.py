@@ -171,6 +171,10 @@ class Autopilot:
     def set_throttle_trim(self, throttle: float) -> None:
         self.throttle_trim = throttle
 
+    def start_from(self, action: np.ndarray) -> None:
+        """Start this episode from the aircraft's start controls (its trimmed throttle)."""
+        self.throttle_trim = float(action[3])
+
     def _value(
         self, obs: list[float], source: str | float | None, hold: str, axis: str = ""
     ) -> float:

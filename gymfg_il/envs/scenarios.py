@@ -70,7 +70,12 @@ class Formation:
             east = back * math.sin(psi) + right * math.cos(psi)
             lat, lon = offset_position(base.latitude_deg, base.longitude_deg, north, east)
             out[plane.callsign] = InitialConditions(
-                lat, lon, base.altitude_ft, heading % 360.0, base.airspeed_kts
+                lat,
+                lon,
+                base.altitude_ft,
+                heading % 360.0,
+                base.airspeed_kts,
+                trimmed=base.trimmed,
             )
         return out
 

@@ -221,7 +221,12 @@ class World:
             own = np.random.default_rng([base, 1 + key])
             ic = ics.get(slot.callsign) or slot.task.initial_conditions(own)
             throttle = slot.aircraft.profile.cruise_throttle
-            slot.state = slot.prev_state = slot.sim.reset(ic, throttle, air)
+            try:
+                slot.state = slot.prev_state = slot.sim.reset(ic, throttle, air)
+            except ConfigError as err:  # an untrimmable start: say whose
+                raise ConfigError(f"{slot.callsign} ({slot.aircraft.model}): {err}") from None
+            if slot.sim.trim is not None:  # a trimmed start flies off at the trim's throttle
+                throttle = slot.sim.trim.throttle
             slot.task.reset(slot.state, own)
             slot.action = slot.prev_action = np.array([0.0, 0.0, 0.0, throttle])
             slot.reward = 0.0

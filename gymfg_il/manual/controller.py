@@ -80,6 +80,10 @@ class ManualController:
     # -- Agent ---------------------------------------------------------------------------
     def reset(self, seed: int | None = None) -> None:
         self.values = np.array([0.0, 0.0, 0.0, self.start_throttle])
+
+    def start_from(self, action: np.ndarray) -> None:
+        """Hold the aircraft's start controls (its trimmed throttle) until the pilot moves."""
+        self.values = np.array(action, dtype=np.float64)
         self.held.clear()
 
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:

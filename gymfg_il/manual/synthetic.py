@@ -269,6 +269,12 @@ class PilotAgent:
         self.human.reset(seed)
         self.pilot.reset(seed)
 
+    def start_from(self, action: np.ndarray) -> None:
+        self.human.start_from(action)
+        start = getattr(self.pilot.intent, "start_from", None)
+        if start is not None:
+            start(action)
+
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
         events = self.pilot.events(observation, self.human.values)
         self.human.handle(events, self.pilot.dt)

@@ -181,6 +181,11 @@ class Rollout:
         for agent in (*self.pilots, *self.experts):
             if agent is not None:
                 agent.reset(seed)
+        for slot, pilot, expert in zip(self._own(), self.pilots, self.experts, strict=True):
+            for agent in (pilot, expert):
+                start = getattr(agent, "start_from", None)
+                if start is not None:
+                    start(slot.action)
         self._rng = np.random.default_rng([seed, NOISE_STREAM])
         self.done = False
         return starts(self.world)

@@ -35,9 +35,9 @@ def ecef_ft(latitude_deg: float, longitude_deg: float, altitude_ft: float) -> tu
 
 @dataclass(frozen=True, slots=True)
 class InitialConditions:
-    """An aircraft's state at the start of an episode: straight flight with a level path,
-    trimmed on request (the pitch and the controls that hold it, found by JSBSim's trim; see
-    ``gymfg_il.sim.trim``).
+    """An aircraft's state at the start of an episode: trimmed straight, level flight by
+    default (the pitch and the controls that hold it, found by JSBSim's trim; see
+    ``gymfg_il.sim.trim``), or an untrimmed start with a given attitude.
 
     Attributes:
         latitude_deg: geodetic latitude.
@@ -49,9 +49,10 @@ class InitialConditions:
         pitch_deg: initial pitch angle.
         terrain_elevation_ft: ground elevation under the aircraft.
         trimmed: start in trimmed straight, level flight (pitch, pitch/roll/yaw trim and
-            throttle from JSBSim's trim at this altitude and airspeed). ``False`` (for now
-            the default) starts with the given roll and pitch, zero trims and the caller's
-            throttle: an untrimmed or unusual start (upset recovery, say).
+            throttle from JSBSim's trim at this altitude and airspeed; the default). A state
+            JSBSim cannot trim is a ``ConfigError`` naming it. ``False`` starts with the given
+            roll and pitch, zero trims and the caller's throttle: an untrimmed or unusual
+            start (upset recovery, say), which opens with a 1-2 s transient.
     """
 
     latitude_deg: float = 37.6189
@@ -62,7 +63,7 @@ class InitialConditions:
     roll_deg: float = 0.0
     pitch_deg: float = 0.0
     terrain_elevation_ft: float = 0.0
-    trimmed: bool = False
+    trimmed: bool = True
 
     def __post_init__(self) -> None:
         problems = []

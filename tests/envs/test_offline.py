@@ -245,9 +245,14 @@ def test_head_on_merge_points_teams_at_each_other():
     env = OfflineEnv([(blue, [ConstantAgent()])], scenario=head_on_merge(distance_ft=20000))
     env.reset(red, seed=0)
     from gymfg_il.sim.properties import StateView
+    from gymfg_il.tasks.orientation import angle_difference_deg
 
     r = StateView(env.world.by_callsign["red-one"].state)
     b = StateView(env.world.by_callsign["blue-one"].state)
     assert geometry.distance_ft(r, b) == pytest.approx(20000, rel=0.01)
-    assert geometry.bearing_deg(r, b) == pytest.approx(r.heading_deg, abs=0.5)
-    assert geometry.bearing_deg(b, r) == pytest.approx(b.heading_deg, abs=0.5)
+    assert angle_difference_deg(geometry.bearing_deg(r, b), r.heading_deg) == pytest.approx(
+        0, abs=0.5
+    )
+    assert angle_difference_deg(geometry.bearing_deg(b, r), b.heading_deg) == pytest.approx(
+        0, abs=0.5
+    )

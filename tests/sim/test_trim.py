@@ -66,7 +66,8 @@ def test_untrimmed_starts_remain_and_show_the_transient():
 def test_a_trimmed_start_is_straight_and_level():
     with pytest.raises(ConfigError, match="trimmed=False"):
         InitialConditions(roll_deg=30.0, trimmed=True)
-    InitialConditions(roll_deg=30.0)  # an untrimmed upset start, on purpose
+    InitialConditions(roll_deg=30.0, trimmed=False)  # an untrimmed upset start, on purpose
+    assert InitialConditions().trimmed  # trimmed by default
 
 
 def test_trims_are_the_same_in_a_fresh_process():
