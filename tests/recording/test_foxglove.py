@@ -200,3 +200,30 @@ def test_team_run_shows_every_aircraft(tmp_path):
     )
     assert np.allclose([first["blue-1"][k] for k in "xyz"], blue_at, atol=1e-6)
     assert np.hypot(*blue_at[:2]) > 1000  # head-on merge: far apart, not drawn on top
+
+
+def test_shipped_layout_shows_what_an_altitude_log_holds(altitude_log):
+    """docs/foxglove-layout.json: every topic and field it plots exists in an altitude log,
+    and observation[10] is the altitude target."""
+    from pathlib import Path
+
+    layout = json.loads((Path(__file__).parents[2] / "docs/foxglove-layout.json").read_text())
+    panels = layout["configById"]
+    msgs, names = messages(altitude_log)
+    three_d = panels["3D!gymfg3d"]
+    assert three_d["followTf"] == "ego" and set(three_d["topics"]) <= set(msgs)
+    assert names[panels["map!gymfgmap"]["followTopic"]] == "foxglove.LocationFix"
+    log = read_log(altitude_log)
+    target_index = log.aircraft("ego")["observation_names"].index("altitude_ft_target")
+    plotted = [p["value"] for p in panels["Plot!gymfgalt"]["paths"]]
+    assert plotted == [
+        f"/gymfg/ego/step.observation[{target_index}]",
+        "/gymfg/ego/state.altitude_ft",
+    ]
+    step, state = msgs["/gymfg/ego/step"][0], msgs["/gymfg/ego/state"][0]
+    assert step["observation"][target_index] == log.complete_episodes[0].steps["ego"].observation[
+        0, target_index
+    ]  # fmt: skip
+    assert "altitude_ft" in state and "elevator" in step["action"]
+    used = {layout["layout"]["first"], *json.dumps(layout["layout"]).split('"')}
+    assert set(panels) <= used
