@@ -25,9 +25,15 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 from typing import Any
+
+import numpy as np
+
+from gymfg_il.sim.properties import INDEX
 
 SCHEMAS = Path(__file__).with_name("foxglove_schemas")
 PARENT_FRAME = "enu"
@@ -43,6 +49,8 @@ _TARGET_COLOUR = {"r": 0.1, "g": 0.9, "b": 0.4, "a": 0.25}
 _PLANE_M = 4000.0  # side of the target-altitude plane
 _LINE_M = 3000.0  # length of the target-heading line
 _UNITS = {"ft": "ft", "deg": "deg", "kt": "kt"}
+_ROLL, _PITCH, _HEADING = INDEX["roll_deg"], INDEX["pitch_deg"], INDEX["heading_deg"]
+_U, _V, _W = INDEX["u_fps"], INDEX["v_fps"], INDEX["w_fps"]
 
 
 @cache
@@ -108,6 +116,25 @@ def attitude(
         "w": cr * cq * cy + sr * sq * sy,
     }
     return rotation, velocity
+
+
+def transform(
+    frame: LocalFrame, ns: int, callsign: str, values: Sequence[float]
+) -> tuple[dict[str, Any], tuple[float, float, float], dict[str, float]]:
+    """(the FrameTransform ``enu`` -> ``callsign`` at log time ``ns`` of the catalogue-ordered
+    state ``values``, its position in ``enu``, its ground velocity in ENU)."""
+    where = frame.enu(values[0], values[1], values[2] * FT_TO_M)
+    rotation, velocity = attitude(
+        values[_ROLL], values[_PITCH], values[_HEADING], (values[_U], values[_V], values[_W])
+    )
+    message = {
+        "timestamp": stamp(ns),
+        "parent_frame_id": PARENT_FRAME,
+        "child_frame_id": callsign,
+        "translation": {"x": where[0], "y": where[1], "z": where[2]},
+        "rotation": rotation,
+    }
+    return message, where, velocity
 
 
 def stamp(ns: int) -> dict[str, int]:
@@ -217,3 +244,37 @@ def target_entities(
         }
         out.append(_entity(ns, PARENT_FRAME, f"{callsign}/aim", lines=[line]))
     return out
+
+
+@dataclass
+class Aim:
+    """A moving target (a dynamic task's) and where the 3D view last drew it: it is redrawn
+    when it has moved by half the task's tolerance."""
+
+    task: dict[str, Any]
+    index: int  # of the target in the observation
+    value: float
+    step: float
+
+    @classmethod
+    def of(cls, task: dict[str, Any], observation: np.ndarray) -> Aim | None:
+        """The target of ``task`` (``Task.describe()``) at the reset ``observation``; None
+        for tasks without one in their observation."""
+        variable = task.get("variable")
+        names = list(task.get("observation", ()))
+        if not isinstance(variable, str) or f"{variable}_target" not in names:
+            return None
+        index = names.index(f"{variable}_target")
+        tolerance = float(task.get("tolerance") or 1.0)
+        return cls(task, index, float(observation[index]), tolerance / 2)
+
+    @property
+    def dynamic(self) -> bool:
+        return bool(self.task.get("dynamic"))
+
+    def moved(self, observation: np.ndarray | Sequence[float]) -> bool:
+        value = float(observation[self.index])
+        if abs(value - self.value) < self.step:
+            return False
+        self.value = value
+        return True

@@ -16,7 +16,6 @@ import math
 import os
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -34,41 +33,8 @@ EPISODE_TOPIC = "/gymfg/episode"
 _FT_TO_M = fg.FT_TO_M
 _DEG_TO_RAD = math.pi / 180.0
 _INITIAL = ("lat_deg", "lon_deg", "altitude_ft")
-_ROLL, _PITCH, _HEADING = INDEX["roll_deg"], INDEX["pitch_deg"], INDEX["heading_deg"]
-_U, _V, _W = INDEX["u_fps"], INDEX["v_fps"], INDEX["w_fps"]
+_HEADING = INDEX["heading_deg"]
 _NO_COVARIANCE = [0.0] * 9
-
-
-@dataclass
-class _Aim:
-    """A moving target (a dynamic task's) and where the 3D view last drew it: it is redrawn
-    when it has moved by half the task's tolerance."""
-
-    task: dict[str, Any]
-    index: int  # of the target in the observation
-    value: float
-    step: float
-
-    @classmethod
-    def of(cls, start: Start) -> _Aim | None:
-        variable = start.task.get("variable")
-        names = list(start.task.get("observation", ()))
-        if not isinstance(variable, str) or f"{variable}_target" not in names:
-            return None
-        index = names.index(f"{variable}_target")
-        tolerance = float(start.task.get("tolerance") or 1.0)
-        return cls(start.task, index, float(start.observation[index]), tolerance / 2)
-
-    @property
-    def dynamic(self) -> bool:
-        return bool(self.task.get("dynamic"))
-
-    def moved(self, observation: Sequence[float] | np.ndarray) -> bool:
-        value = float(observation[self.index])
-        if abs(value - self.value) < self.step:
-            return False
-        self.value = value
-        return True
 
 
 def _start_record(s: Start) -> dict[str, Any]:
@@ -172,7 +138,7 @@ class TrajectoryWriter:
             c: (a.get("model", ""), teams.index(a["team"])) for c, a in session["aircraft"].items()
         }
         self._frame = fg.LocalFrame(0.0, 0.0, 0.0)
-        self._aims: dict[str, _Aim] = {}
+        self._aims: dict[str, fg.Aim] = {}
         self._views = (
             {t: w.register_channel(view_topic(t), "json", view) for t in teams}
             if len(teams) > 1 or session.get("online")
@@ -244,7 +210,7 @@ class TrajectoryWriter:
             where, _ = self._transform(s.callsign, values)
             model, team = self._look.get(s.callsign, ("", 0))
             entities = [fg.aircraft_entity(self._clock_ns, s.callsign, model, team)]
-            aim = _Aim.of(s)
+            aim = fg.Aim.of(s.task, s.observation)
             entities += fg.target_entities(
                 self._clock_ns, s.callsign, s.task, aim.value if aim else s.target, where,
                 self._frame,
@@ -259,20 +225,8 @@ class TrajectoryWriter:
     ) -> tuple[tuple[float, float, float], dict[str, float]]:
         """Log ``callsign``'s pose in ``enu`` (a FrameTransform); (its position there, its
         ground velocity in ENU)."""
-        where = self._frame.enu(values[0], values[1], values[2] * _FT_TO_M)
-        rotation, velocity = fg.attitude(
-            values[_ROLL], values[_PITCH], values[_HEADING], (values[_U], values[_V], values[_W])
-        )
-        self._emit(
-            self._tfs[callsign],
-            {
-                "timestamp": fg.stamp(self._clock_ns),
-                "parent_frame_id": fg.PARENT_FRAME,
-                "child_frame_id": callsign,
-                "translation": {"x": where[0], "y": where[1], "z": where[2]},
-                "rotation": rotation,
-            },
-        )
+        message, where, velocity = fg.transform(self._frame, self._clock_ns, callsign, values)
+        self._emit(self._tfs[callsign], message)
         return where, velocity
 
     def log_tick(self, tick: Tick) -> None:
