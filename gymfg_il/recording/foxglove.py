@@ -3,7 +3,7 @@
 Per step and aircraft the writer adds a ``foxglove.FrameTransform`` and fills
 ``foxglove.LocationFix.heading`` and ``velocity``; per episode and aircraft a
 ``foxglove.SceneUpdate`` draws the aircraft in its own frame (so the transforms move it) and
-the task's target, redrawn while a dynamic target moves. Foxglove matches these schemas by
+the task's target, redrawn while a dynamic target moves (``Aim``). Foxglove matches these schemas by
 name and field layout: ``foxglove_schemas/`` holds them exactly as ``@foxglove/schemas``
 1.13.0 publishes them (MIT licence, Foxglove Technologies; see its README).
 
