@@ -5,6 +5,7 @@
     python -m gymfg_il.collect recover DIR                   # rebuild DIR/dataset from DIR/logs
     python -m gymfg_il.collect repair EDITED --source ORIGINAL   # after lerobot-edit-dataset
     python -m gymfg_il.collect replay DIR                    # re-fly logged episodes, compare
+    python -m gymfg_il.collect reindex DIR                   # older logs: add message indexes
     python -m gymfg_il.collect dagger --policy P --out DIR   # DAgger with the controller
     python -m gymfg_il.collect manual --device keyboard --out DIR   # a person flies
 
@@ -58,7 +59,12 @@ def _running(p: argparse.ArgumentParser) -> None:
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
     from gymfg_il import cli
-    from gymfg_il.collectors.commands import RecoverConfig, RepairConfig, ReplayConfig
+    from gymfg_il.collectors.commands import (
+        RecoverConfig,
+        ReindexConfig,
+        RepairConfig,
+        ReplayConfig,
+    )
     from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.learning.dagger import DaggerConfig
 
@@ -83,7 +89,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         EPILOG,
     )
     sub = p.add_subparsers(
-        dest="command", metavar="{autopilot,manual,dagger,recover,repair,replay,RECIPE.toml}"
+        dest="command",
+        metavar="{autopilot,manual,dagger,recover,repair,replay,reindex,RECIPE.toml}",
     )
     auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
     cli.add_fields(auto, CollectConfig, only=AUTOPILOT)
@@ -117,6 +124,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     cli.add_fields(repair, RepairConfig)
     replay = sub.add_parser("replay", help=cli.summary(ReplayConfig))
     cli.add_fields(replay, ReplayConfig)
+    reindex = sub.add_parser("reindex", help=cli.summary(ReindexConfig))
+    cli.add_fields(reindex, ReindexConfig)
     args = p.parse_args(argv)
     if args.command is None:
         p.print_help()
@@ -286,6 +295,13 @@ def _replay(args: argparse.Namespace) -> int:
     return replay(cfg.log, cfg.episode, cfg.view)
 
 
+def _reindex(args: argparse.Namespace) -> int:
+    from gymfg_il import cli
+    from gymfg_il.collectors.commands import ReindexConfig, reindex
+
+    return reindex(cli.build(ReindexConfig, args).logs)
+
+
 COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "autopilot": _autopilot,
     "recipe": _autopilot,
@@ -294,6 +310,7 @@ COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "recover": _recover,
     "repair": _repair,
     "replay": _replay,
+    "reindex": _reindex,
 }
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
-"""The bodies of ``collect recover``, ``repair`` and ``replay`` (``gymfg_il.collect`` parses)."""
+"""The bodies of ``collect recover``, ``repair``, ``replay`` and ``reindex``
+(``gymfg_il.collect`` parses)."""
 
 from __future__ import annotations
 
@@ -66,6 +67,19 @@ class ReplayConfig:
         bad = [p for p in self.view if not 0 < p < 65536]
         if bad:
             raise ConfigError(f"--view {bad[0]}: a UDP port is 1..65535")
+
+
+@dataclass
+class ReindexConfig:
+    """Give older logs the message indexes Foxglove's reader needs, in place and crash-safely
+    (a verified copy replaces each file atomically); logs that have them are left untouched,
+    damaged or unfinished ones are refused and left as they were.
+
+    Attributes:
+        logs: .mcap logs or folders (every .mcap under them).
+    """
+
+    logs: list[Path] = field(metadata={"positional": True})
 
 
 def report_build(report: BuildReport, root: Path) -> None:
@@ -167,3 +181,36 @@ def repair(folder: Path, sources: Sequence[Path]) -> int:
     restored = restore(root, meta, [dataset(s) for s in sources])
     print(f"dataset {root}: restored the gymfg/* columns of {restored} episodes")
     return 0
+
+
+def reindex(targets: Sequence[Path]) -> int:
+    """Re-index every log at ``targets`` (files or folders); 1 if any was refused."""
+    from gymfg_il.recording.indexes import reindex as reindex_log
+    from gymfg_il.recording.reader import LogError
+
+    paths = []
+    for target in targets:
+        if target.is_dir():
+            paths += sorted(target.rglob("*.mcap"))
+        elif target.is_file():
+            paths.append(target)
+        else:
+            raise ConfigError(f"{target}: no such log or folder")
+    if not paths:
+        raise ConfigError(f"no .mcap logs under {', '.join(map(str, targets))}")
+    refused = 0
+    for path in paths:
+        try:
+            r = reindex_log(path)
+        except LogError as err:
+            print(f"refused {path}: {err}", file=sys.stderr)
+            refused += 1
+            continue
+        if r.changed:
+            print(
+                f"reindexed {path}: {r.messages} messages ({'; '.join(r.problems)} before); "
+                f"{r.size_before:,} -> {r.size_after:,} bytes"
+            )
+        else:
+            print(f"{path}: already has message indexes; left untouched")
+    return 1 if refused else 0

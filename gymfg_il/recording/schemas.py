@@ -7,7 +7,12 @@ Channels (Foxglove conventions: JSON messages with a ``jsonschema`` schema):
 - ``/gymfg/<callsign>/step`` (``gymfg.Step``): every agent step: observation, action, label
   (the demonstrator's action), reward, flags.
 - ``/gymfg/<callsign>/state`` (``gymfg.State``): the full state after every step.
-- ``/gymfg/<callsign>/location`` (``foxglove.LocationFix``): position for Foxglove's map.
+- ``/gymfg/<callsign>/location`` (``foxglove.LocationFix``): position, heading and velocity
+  for Foxglove's Map.
+- ``/gymfg/<callsign>/tf`` (``foxglove.FrameTransform``): the aircraft's pose in the episode's
+  local ENU frame, for Foxglove's 3D panel (``recording.foxglove`` gives the conventions).
+- ``/gymfg/<callsign>/scene`` (``foxglove.SceneUpdate``): the aircraft drawn in its frame and
+  its task's target (at the reset, and again whenever a dynamic target has moved).
 - ``/gymfg/team/<team>/opponents`` (``gymfg.OpponentView``): what a team saw of the other
   teams after every step (team runs only).
 
@@ -21,6 +26,7 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping
 
+from gymfg_il.recording import foxglove
 from gymfg_il.sim.properties import ACTION_NAMES, CATALOGUE
 
 _ACTION = {
@@ -97,23 +103,8 @@ OPPONENT_VIEW = {
     },
 }
 
-# Foxglove's built-in schema is matched by its exact name.
-LOCATION_FIX = {
-    "title": "foxglove.LocationFix",
-    "type": "object",
-    "properties": {
-        "timestamp": {
-            "type": "object",
-            "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}},
-        },
-        "frame_id": {"type": "string"},
-        "latitude": {"type": "number"},
-        "longitude": {"type": "number"},
-        "altitude": {"type": "number", "description": "meters above the WGS84 ellipsoid"},
-        "position_covariance": {"type": "array", "items": {"type": "number"}},
-        "position_covariance_type": {"type": "integer"},
-    },
-}
+# Foxglove's built-in schema, matched by its exact name and field layout: Foxglove's own.
+LOCATION_FIX = foxglove.schema("foxglove.LocationFix")
 
 
 def encoded(schema: Mapping[str, object]) -> bytes:

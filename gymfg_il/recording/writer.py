@@ -12,6 +12,7 @@ workers). Both end in the same messages.
 from __future__ import annotations
 
 import json
+import math
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -22,14 +23,18 @@ import numpy as np
 import orjson
 from mcap.writer import CompressionType, IndexType, Writer
 
+from gymfg_il.recording import foxglove as fg
 from gymfg_il.recording import schemas
 from gymfg_il.recording.session import SESSION_METADATA
 from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
-from gymfg_il.sim.properties import ACTION_NAMES, NAMES
+from gymfg_il.sim.properties import ACTION_NAMES, INDEX, NAMES
 
 EPISODE_TOPIC = "/gymfg/episode"
-_FT_TO_M = 0.3048
+_FT_TO_M = fg.FT_TO_M
+_DEG_TO_RAD = math.pi / 180.0
 _INITIAL = ("lat_deg", "lon_deg", "altitude_ft")
+_HEADING = INDEX["heading_deg"]
+_NO_COVARIANCE = [0.0] * 9
 
 
 def _start_record(s: Start) -> dict[str, Any]:
@@ -55,6 +60,14 @@ def state_topic(callsign: str) -> str:
 
 def location_topic(callsign: str) -> str:
     return f"/gymfg/{callsign}/location"
+
+
+def transform_topic(callsign: str) -> str:
+    return f"/gymfg/{callsign}/tf"
+
+
+def scene_topic(callsign: str) -> str:
+    return f"/gymfg/{callsign}/scene"
 
 
 def view_topic(team: str) -> str:
@@ -111,10 +124,21 @@ class TrajectoryWriter:
             schema("foxglove.LocationFix", schemas.LOCATION_FIX),
             schema("gymfg.OpponentView", schemas.OPPONENT_VIEW),
         )
+        tf, scene = (
+            schema("foxglove.FrameTransform", fg.schema("foxglove.FrameTransform")),
+            schema("foxglove.SceneUpdate", fg.schema("foxglove.SceneUpdate")),
+        )
         self._events = w.register_channel(EPISODE_TOPIC, "json", event)
         self._steps = {c: w.register_channel(step_topic(c), "json", step) for c in callsigns}
         self._states = {c: w.register_channel(state_topic(c), "json", state) for c in callsigns}
         self._fixes = {c: w.register_channel(location_topic(c), "json", fix) for c in callsigns}
+        self._tfs = {c: w.register_channel(transform_topic(c), "json", tf) for c in callsigns}
+        self._scenes = {c: w.register_channel(scene_topic(c), "json", scene) for c in callsigns}
+        self._look = {
+            c: (a.get("model", ""), teams.index(a["team"])) for c, a in session["aircraft"].items()
+        }
+        self._frame = fg.LocalFrame(0.0, 0.0, 0.0)
+        self._aims: dict[str, fg.Aim] = {}
         self._views = (
             {t: w.register_channel(view_topic(t), "json", view) for t in teams}
             if len(teams) > 1 or session.get("online")
@@ -168,7 +192,42 @@ class TrajectoryWriter:
         if options:
             event["options"] = dict(options)
         self._emit(self._events, {**event, **info})
+        self._draw_starts(starts)
         return self.episode
+
+    def _draw_starts(self, starts: Sequence[Start]) -> None:
+        """Foxglove's 3D view at the reset: anchor the ``enu`` frame at the first aircraft,
+        place every aircraft, draw it and its task's target (``recording.foxglove``)."""
+        if not starts:
+            return
+        lat, lon, alt_ft = starts[0].state[:3].tolist()
+        self._frame = fg.LocalFrame(lat, lon, alt_ft * _FT_TO_M)
+        self._aims = {}
+        for s in starts:
+            if s.callsign not in self._scenes:
+                continue
+            values = s.state.tolist()
+            where, _ = self._transform(s.callsign, values)
+            model, team = self._look.get(s.callsign, ("", 0))
+            entities = [fg.aircraft_entity(self._clock_ns, s.callsign, model, team)]
+            aim = fg.Aim.of(s.task, s.observation)
+            entities += fg.target_entities(
+                self._clock_ns, s.callsign, s.task, aim.value if aim else s.target, where,
+                self._frame,
+            )  # fmt: skip
+            deletion = {"timestamp": fg.stamp(self._clock_ns), "type": 1, "id": ""}
+            self._emit(self._scenes[s.callsign], {"deletions": [deletion], "entities": entities})
+            if aim is not None and aim.dynamic:
+                self._aims[s.callsign] = aim
+
+    def _transform(
+        self, callsign: str, values: list[float]
+    ) -> tuple[tuple[float, float, float], dict[str, float]]:
+        """Log ``callsign``'s pose in ``enu`` (a FrameTransform); (its position there, its
+        ground velocity in ENU)."""
+        message, where, velocity = fg.transform(self._frame, self._clock_ns, callsign, values)
+        self._emit(self._tfs[callsign], message)
+        return where, velocity
 
     def log_tick(self, tick: Tick) -> None:
         """Log one agent step of the flight: every aircraft's step and each team's view."""
@@ -241,19 +300,27 @@ class TrajectoryWriter:
             self._states[callsign],
             {"episode": self.episode, "step": step, **dict(zip(NAMES, values, strict=True))},
         )
-        sec, nsec = divmod(self._clock_ns, 1_000_000_000)
+        where, velocity = self._transform(callsign, values)
         self._emit(
             self._fixes[callsign],
             {
-                "timestamp": {"sec": sec, "nsec": nsec},
+                "timestamp": fg.stamp(self._clock_ns),
                 "frame_id": callsign,
                 "latitude": values[0],
                 "longitude": values[1],
                 "altitude": values[2] * _FT_TO_M,
-                "position_covariance": [0.0] * 9,
+                "position_covariance": _NO_COVARIANCE,
                 "position_covariance_type": 0,
+                "heading": values[_HEADING] * _DEG_TO_RAD,
+                "velocity": velocity,
             },
         )
+        aim = self._aims.get(callsign)
+        if aim is not None and aim.moved(observation):
+            entities = fg.target_entities(
+                self._clock_ns, callsign, aim.task, aim.value, where, self._frame
+            )
+            self._emit(self._scenes[callsign], {"deletions": [], "entities": entities})
 
     def log_view(self, team: str, step: int, view: OpponentView) -> None:
         """Log what ``team`` saw of the other teams after agent step ``step``."""
