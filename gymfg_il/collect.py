@@ -7,6 +7,8 @@
     python -m gymfg_il.collect replay DIR                    # re-fly logged episodes, compare
     python -m gymfg_il.collect dagger --policy P --out DIR   # DAgger with the controller
     python -m gymfg_il.collect manual --device keyboard --out DIR   # a person flies
+    python -m gymfg_il.collect export acmi LOG --out FLIGHT.acmi      # for Tacview
+    python -m gymfg_il.collect export minari DIR --name gymfg/roll-v0 --root MINARI_DIR
 
 A session folder holds ``logs/`` (one MCAP log per session: every step, the write-ahead log)
 and ``dataset/`` (LeRobot v3.0). Collecting into an existing folder appends.
@@ -83,7 +85,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         EPILOG,
     )
     sub = p.add_subparsers(
-        dest="command", metavar="{autopilot,manual,dagger,recover,repair,replay,RECIPE.toml}"
+        dest="command",
+        metavar="{autopilot,manual,dagger,recover,repair,replay,export,RECIPE.toml}",
     )
     auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
     cli.add_fields(auto, CollectConfig, only=AUTOPILOT)
@@ -117,11 +120,25 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     cli.add_fields(repair, RepairConfig)
     replay = sub.add_parser("replay", help=cli.summary(ReplayConfig))
     cli.add_fields(replay, ReplayConfig)
+    _exports(sub)
     args = p.parse_args(argv)
     if args.command is None:
         p.print_help()
         p.exit(2)
     return args
+
+
+def _exports(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    from gymfg_il import cli
+    from gymfg_il.export.acmi import AcmiConfig
+    from gymfg_il.export.minari import MinariConfig
+
+    export = sub.add_parser(
+        "export", help="a log or dataset in another tool's format: Tacview (acmi), Minari"
+    )
+    formats = export.add_subparsers(dest="format", metavar="{acmi,minari}", required=True)
+    cli.add_fields(formats.add_parser("acmi", help=cli.summary(AcmiConfig)), AcmiConfig)
+    cli.add_fields(formats.add_parser("minari", help=cli.summary(MinariConfig)), MinariConfig)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -286,6 +303,18 @@ def _replay(args: argparse.Namespace) -> int:
     return replay(cfg.log, cfg.episode, cfg.view)
 
 
+def _export(args: argparse.Namespace) -> int:
+    from gymfg_il import cli
+
+    if args.format == "acmi":
+        from gymfg_il.export.acmi import AcmiConfig, export_acmi
+
+        return export_acmi(cli.build(AcmiConfig, args))
+    from gymfg_il.export.minari import MinariConfig, export_minari
+
+    return export_minari(cli.build(MinariConfig, args))
+
+
 COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "autopilot": _autopilot,
     "recipe": _autopilot,
@@ -294,6 +323,7 @@ COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "recover": _recover,
     "repair": _repair,
     "replay": _replay,
+    "export": _export,
 }
 
 if __name__ == "__main__":
