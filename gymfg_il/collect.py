@@ -128,7 +128,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     return args
 
 
-def _exports(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _exports(sub: argparse._SubParsersAction) -> None:
     from gymfg_il import cli
     from gymfg_il.export.acmi import AcmiConfig
     from gymfg_il.export.minari import MinariConfig

@@ -118,10 +118,16 @@ def escape(text: str) -> str:
     return text.replace("\\", "\\\\").replace(",", "\\,").replace("\n", "\\\n")
 
 
+def _angle(value: float) -> str:
+    text = f"{value:.2f}"
+    return "0.00" if text == "-0.00" else text
+
+
 def _pose(row: np.ndarray) -> str:
     lon, lat, alt_ft, roll, pitch = (float(row[i]) for i in _POSE)
     yaw = float(row[_YAW]) % 360.0
-    return f"T={lon:.7f}|{lat:.7f}|{alt_ft * FT_TO_M:.2f}|{roll:.2f}|{pitch:.2f}|{yaw:.2f}"
+    angles = "|".join(_angle(a) for a in (roll, pitch, yaw))
+    return f"T={lon:.7f}|{lat:.7f}|{alt_ft * FT_TO_M:.2f}|{angles}"
 
 
 def _telemetry(row: np.ndarray) -> str:
