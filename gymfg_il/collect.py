@@ -133,9 +133,8 @@ def _exports(sub: argparse._SubParsersAction) -> None:
     from gymfg_il.export.acmi import AcmiConfig
     from gymfg_il.export.minari import MinariConfig
 
-    export = sub.add_parser(
-        "export", help="a log or dataset in another tool's format: Tacview (acmi), Minari"
-    )
+    what = "a log or dataset in another tool's format: Tacview (acmi), Minari (minari)"
+    export = sub.add_parser("export", help=what, description=what[0].upper() + what[1:] + ".")
     formats = export.add_subparsers(dest="format", metavar="{acmi,minari}", required=True)
     cli.add_fields(formats.add_parser("acmi", help=cli.summary(AcmiConfig)), AcmiConfig)
     cli.add_fields(formats.add_parser("minari", help=cli.summary(MinariConfig)), MinariConfig)

@@ -67,7 +67,7 @@ class MinariConfig:
     """
 
     dataset: Path = field(metadata={"positional": True})
-    name: str = field(default="")
+    name: str
     root: Path | None = None
 
     def __post_init__(self) -> None:

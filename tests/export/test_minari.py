@@ -106,3 +106,31 @@ def test_what_cannot_be_exported_says_why(noisy, tmp_path):
         export_dataset(tmp_path / "nowhere", NAME, tmp_path / "m")
     with pytest.raises(ConfigError, match="a Minari dataset id is"):
         MinariConfig(noisy, "roll")
+
+
+def test_a_team_run_is_refused_by_name(tmp_path):
+    from gymfg_il import Team
+    from gymfg_il.aircraft import c172p
+    from gymfg_il.collectors.commands import recover
+    from gymfg_il.controllers.agent import RandomAgent
+    from gymfg_il.envs import OfflineEnv
+    from gymfg_il.recording.recorder import Recorder
+    from gymfg_il.tasks import ReachStaticTargetAltitudeTask
+
+    # two aircraft alike (same model, task, settings): one flight spec, but flown together
+    pair = Team(
+        "pair",
+        [(c172p(c), ReachStaticTargetAltitudeTask) for c in ("lead", "wing")],
+        episode_time_s=1,
+    )
+    env = Recorder(OfflineEnv(), tmp_path)
+    pilot = RandomAgent(0.2)
+    env.reset(pair, seed=0)
+    done = False
+    while not done:
+        *_, terminated, truncated, _ = env.step(np.hstack([pilot.act(None)] * 2))
+        done = terminated or truncated
+    env.close()
+    assert recover(tmp_path) == 0
+    with pytest.raises(ConfigError, match="holds team-run episodes \\(lead, wing flew beside"):
+        export_dataset(tmp_path, NAME, tmp_path / "m")
