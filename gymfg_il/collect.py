@@ -8,6 +8,8 @@
     python -m gymfg_il.collect reindex DIR                   # older logs: add message indexes
     python -m gymfg_il.collect dagger --policy P --out DIR   # DAgger with the controller
     python -m gymfg_il.collect manual --device keyboard --out DIR   # a person flies
+    python -m gymfg_il.collect export acmi LOG --out FLIGHT.acmi      # for Tacview
+    python -m gymfg_il.collect export minari DIR --name gymfg/roll-v0 --root MINARI_DIR
 
 A session folder holds ``logs/`` (one MCAP log per session: every step, the write-ahead log)
 and ``dataset/`` (LeRobot v3.0). Collecting into an existing folder appends.
@@ -90,7 +92,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     )
     sub = p.add_subparsers(
         dest="command",
-        metavar="{autopilot,manual,dagger,recover,repair,replay,reindex,RECIPE.toml}",
+        metavar="{autopilot,manual,dagger,recover,repair,replay,reindex,export,RECIPE.toml}",
     )
     auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
     cli.add_fields(auto, CollectConfig, only=AUTOPILOT)
@@ -126,11 +128,24 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     cli.add_fields(replay, ReplayConfig)
     reindex = sub.add_parser("reindex", help=cli.summary(ReindexConfig))
     cli.add_fields(reindex, ReindexConfig)
+    _exports(sub)
     args = p.parse_args(argv)
     if args.command is None:
         p.print_help()
         p.exit(2)
     return args
+
+
+def _exports(sub: argparse._SubParsersAction) -> None:
+    from gymfg_il import cli
+    from gymfg_il.export.acmi import AcmiConfig
+    from gymfg_il.export.minari import MinariConfig
+
+    what = "a log or dataset in another tool's format: Tacview (acmi), Minari (minari)"
+    export = sub.add_parser("export", help=what, description=what[0].upper() + what[1:] + ".")
+    formats = export.add_subparsers(dest="format", metavar="{acmi,minari}", required=True)
+    cli.add_fields(formats.add_parser("acmi", help=cli.summary(AcmiConfig)), AcmiConfig)
+    cli.add_fields(formats.add_parser("minari", help=cli.summary(MinariConfig)), MinariConfig)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -302,6 +317,18 @@ def _reindex(args: argparse.Namespace) -> int:
     return reindex(cli.build(ReindexConfig, args).logs)
 
 
+def _export(args: argparse.Namespace) -> int:
+    from gymfg_il import cli
+
+    if args.format == "acmi":
+        from gymfg_il.export.acmi import AcmiConfig, export_acmi
+
+        return export_acmi(cli.build(AcmiConfig, args))
+    from gymfg_il.export.minari import MinariConfig, export_minari
+
+    return export_minari(cli.build(MinariConfig, args))
+
+
 COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "autopilot": _autopilot,
     "recipe": _autopilot,
@@ -311,6 +338,7 @@ COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "repair": _repair,
     "replay": _replay,
     "reindex": _reindex,
+    "export": _export,
 }
 
 if __name__ == "__main__":

@@ -24,7 +24,7 @@ LAYERS = [
     {"datasets"},
     {"collectors"},
     {"learning"},
-    {"evaluation"},
+    {"evaluation", "export"},
     {"cli", "collect", "train", "eval", "serve", "demo", "lerobot_env"},
 ]
 LAYER = {name: i for i, names in enumerate(LAYERS) for name in names}

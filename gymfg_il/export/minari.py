@@ -1,0 +1,337 @@
+"""A dataset as a Minari dataset (Farama's offline-RL format): ``collect export minari DIR``.
+
+    python -m gymfg_il.collect export minari runs/roll --name gymfg/roll-c172p-v0 --root data
+    MINARI_DATASETS_PATH=data python -c "import minari; d = minari.load_dataset(
+        'gymfg/roll-c172p-v0'); env = d.recover_environment()"
+
+Each dataset episode becomes a Minari episode: ``observations`` (N + 1 rows: the reset's and
+the one after every step), ``actions`` (N: what the env was stepped with), ``rewards``,
+``terminations`` and ``truncations`` (N), its ``seed``, and ``infos["label"]`` (the
+demonstrator's action, the dataset's ``action`` column; N + 1 rows, the last repeated).
+
+A LeRobot frame holds the observation an action was chosen from, not the one after the last
+step, so the export re-flies every episode in the env it names, from its seed, and takes the
+final observation, rewards and flags from that flight. The flown actions come from the
+session's logs (``DIR/logs`` beside ``DIR/dataset``), and the re-flown observations must then
+equal the dataset's bit for bit. Without the logs the dataset's ``action`` column is flown:
+that is what was flown only without collection noise (DART's ``--noise``, 0.02 by default,
+is in the log alone, so such a dataset needs its logs), and being float32 it re-flies within
+rounding (measured: at most 5e-6 relative over 90 s; ``NEAR`` allows 1e-3), so the dataset's
+own observations are kept and only the last comes from the flight. Actions are stored as
+float32, the action space's dtype.
+
+The Minari dataset's env spec is the registered GymFG id of the task (``GymFG/Roll-v0``) with
+every keyword of the flight: aircraft, dynamic, task_kwargs, agent_hz, sim_hz,
+episode_time_s, turbulence, wind_kt, wind_from_deg; ``recover_environment()`` makes it with
+``gymnasium.make`` and its spaces are the dataset's. Only solo flights export (a team run's
+aircraft flew beside others, which no single gymnasium env reproduces). Nothing touches the
+network: Minari writes under ``root`` (its ``MINARI_DATASETS_PATH``) in its Arrow format.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import re
+import shutil
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.errors import ConfigError
+
+DATA_FORMAT = "arrow"  # Minari's Arrow storage: pyarrow is here already (LeRobot); no h5py
+NEAR = 1e-3  # relative drift allowed when re-flying from float32 actions (no logs at hand)
+_ID = re.compile(r"^([\w.-]+/)*[\w.-]+-v\d+$")
+
+
+@dataclass
+class MinariConfig:
+    """Turn one of our LeRobot datasets into a Minari dataset (episodes with observations,
+    actions, rewards, terminations, truncations) that minari.load_dataset opens and whose
+    recover_environment() makes the GymFG env it was flown in; nothing touches the network.
+
+    Attributes:
+        dataset: a session folder (dataset/ and logs/ inside) or a dataset folder (meta/
+            inside).
+        name: the Minari dataset id, (namespace/)name-vN, e.g. gymfg/roll-c172p-v0.
+        root: the folder Minari keeps its datasets in; open them with
+            MINARI_DATASETS_PATH=ROOT (default: $MINARI_DATASETS_PATH, else
+            ~/.minari/datasets).
+    """
+
+    dataset: Path = field(metadata={"positional": True})
+    name: str
+    root: Path | None = None
+
+    def __post_init__(self) -> None:
+        if not _ID.match(self.name):
+            raise ConfigError(
+                f"--name {self.name!r}: a Minari dataset id is (namespace/)name-vN, e.g. "
+                "gymfg/roll-c172p-v0"
+            )
+
+
+@dataclass
+class MinariSummary:
+    """What ``export_dataset`` wrote."""
+
+    name: str
+    root: Path
+    episodes: int
+    steps: int
+    env_id: str
+
+
+def env_spec(flight: FlightSpec) -> Any:
+    """The gymnasium ``EnvSpec`` of a solo flight: its task's registered id with every
+    keyword ``AircraftEnv`` needs to fly it again."""
+    import gymnasium as gym
+
+    from gymfg_il.envs.registration import IDS, register_envs
+
+    register_envs()
+    ego = flight.solo_aircraft
+    ids = {family: env_id for env_id, family in IDS.items()}
+    if ego.task not in ids:
+        raise ConfigError(
+            f"task {ego.task!r} has no registered GymFG id (known: {', '.join(sorted(ids))}); "
+            "only the registered tasks export to Minari"
+        )
+    base = gym.spec(ids[ego.task])
+    kwargs = {
+        **base.kwargs,
+        "aircraft": ego.model,
+        "dynamic": ego.dynamic,
+        "task_kwargs": dict(ego.task_kwargs),
+        "agent_hz": flight.agent_hz,
+        "sim_hz": flight.sim_hz,
+        "episode_time_s": flight.episode_time_s,
+        "turbulence": flight.turbulence,
+        "wind_kt": flight.wind_kt,
+        "wind_from_deg": flight.wind_from_deg,
+    }
+    import json
+
+    kwargs = json.loads(json.dumps(kwargs))  # plain JSON data: Minari stores the spec as JSON
+    return dataclasses.replace(base, kwargs=kwargs)
+
+
+@contextmanager
+def minari_root(root: Path | None) -> Iterator[Path]:
+    """Minari's datasets folder set to ``root`` (it reads ``MINARI_DATASETS_PATH`` only) while
+    inside, as it was afterwards."""
+    before = os.environ.get("MINARI_DATASETS_PATH")
+    if root is None:
+        root = Path(before) if before else Path.home() / ".minari" / "datasets"
+    root = Path(root).expanduser().resolve()  # Minari's Arrow storage fails on relative paths
+    os.environ["MINARI_DATASETS_PATH"] = str(root)
+    try:
+        yield root
+    finally:
+        if before is None:
+            os.environ.pop("MINARI_DATASETS_PATH", None)
+        else:
+            os.environ["MINARI_DATASETS_PATH"] = before
+
+
+def _locate(path: Path) -> tuple[Path, Path | None]:
+    """(the dataset folder, the session's logs folder if there is one)."""
+    path = Path(path)
+    root = path / "dataset" if (path / "dataset" / "meta").is_dir() else path
+    if not (root / "meta" / "info.json").is_file():
+        raise ConfigError(
+            f"no LeRobot dataset at {path} (no meta/info.json); give a session folder from "
+            "`python -m gymfg_il.collect autopilot --out DIR` or its DIR/dataset"
+        )
+    logs = root.parent / "logs"
+    return root, logs if logs.is_dir() else None
+
+
+class _FlownActions:
+    """Each episode's flown actions: from its log when the session's logs are at hand."""
+
+    def __init__(self, logs: Path | None) -> None:
+        self.logs = logs
+        self._read: dict[str, Any] = {}
+
+    def __call__(self, meta: dict[str, Any], labels: np.ndarray) -> tuple[np.ndarray, bool]:
+        """(the flown actions, whether they are the exact ones: from the log)."""
+        name, index = meta.get("gymfg/log"), meta.get("gymfg/log_episode")
+        callsign = meta.get("gymfg/callsign", "ego")
+        if self.logs is not None and name and (self.logs / name).is_file():
+            from gymfg_il.recording.reader import read_log
+
+            if name not in self._read:
+                self._read[name] = read_log(self.logs / name)
+            for ep in self._read[name].complete_episodes:
+                if ep.index == index and callsign in ep.steps:
+                    return ep.steps[callsign].action, True
+        if float(meta.get("gymfg/noise", 0.0) or 0.0) > 0.0:
+            raise ConfigError(
+                f"episode {meta['episode_index']} was flown with noise "
+                f"{meta['gymfg/noise']}: its flown actions are only in its log {name}, which "
+                f"is not under {self.logs or 'a logs/ folder beside the dataset'}; export the "
+                "session folder that holds it"
+            )
+        return labels.astype(np.float64), False
+
+
+def _refly(
+    env: Any,
+    meta: dict[str, Any],
+    obs: np.ndarray,
+    flown_actions: tuple[np.ndarray, bool],
+    labels: np.ndarray,
+) -> Any:
+    """Fly one episode again in ``env``; its Minari buffer, or a clear error where it departs
+    from the dataset (``flown_actions``: exact ones must give the dataset's observations bit
+    for bit, float32-rounded ones within ``NEAR``)."""
+    from minari.data_collector import EpisodeBuffer
+
+    actions, exact = flown_actions
+    index, seed = int(meta["episode_index"]), int(meta["gymfg/seed"])
+    first, _ = env.reset(seed=seed)
+    observations = [np.asarray(first, np.float32)]
+    rewards, terms, truncs = [], [], []
+    for t, action in enumerate(actions):
+        ob, reward, terminated, truncated, _ = env.step(action)
+        observations.append(np.asarray(ob, np.float32))
+        rewards.append(float(reward))
+        terms.append(bool(terminated))
+        truncs.append(bool(truncated))
+        if (terminated or truncated) and t < len(actions) - 1:
+            raise ConfigError(
+                f"episode {index} (seed {seed}) ends after {t + 1} steps when flown again "
+                f"in its env, but the dataset holds {len(actions)}"
+            )
+    if not (terms[-1] or truncs[-1]):
+        raise ConfigError(
+            f"episode {index} (seed {seed}) has not ended after its {len(actions)} steps when "
+            "flown again in its env"
+        )
+    flown = np.stack(observations)
+    if exact:
+        apart = flown[: len(obs)] != obs
+    else:  # float32-rounded actions: the flight drifts by rounding only
+        apart = np.abs(flown[: len(obs)] - obs) > NEAR * (1.0 + np.abs(obs))
+    differs = np.flatnonzero(np.any(apart, axis=1))
+    if len(differs):
+        why = (
+            "a dataset edited by hand, or collected by another version"
+            if exact
+            else "flown again from its float32 actions it drifted; export the session folder "
+            "with its logs/, which hold the exact actions"
+        )
+        raise ConfigError(
+            f"episode {index} (seed {seed}) departs from the dataset at frame {differs[0]} "
+            f"when flown again in its env ({why}); it cannot be exported with its env"
+        )
+    if not exact:
+        flown[: len(obs)] = obs  # the dataset's own; only the last comes from the flight
+    return EpisodeBuffer(
+        id=None,
+        seed=seed,
+        observations=flown,
+        actions=actions.astype(np.float32),  # the action space's dtype
+        rewards=np.array(rewards),
+        terminations=np.array(terms),
+        truncations=np.array(truncs),
+        infos={"label": np.concatenate([labels, labels[-1:]])},
+    )
+
+
+def export_dataset(dataset: Path, name: str, root: Path | None = None) -> MinariSummary:
+    """Write the LeRobot dataset at ``dataset`` as the Minari dataset ``name`` under
+    ``root`` (see the module docstring); what was written."""
+    import gymnasium as gym
+    import minari
+
+    from gymfg_il.learning.data import load_frames
+
+    MinariConfig(dataset, name, root)  # the id's rule
+    folder, logs = _locate(dataset)
+    frames = load_frames(folder)
+    flight, why = frames.flight()
+    if flight is None:
+        raise ConfigError(f"the dataset at {folder} names no one flight: {why}")
+    team_runs = {
+        c for c, s in zip(frames.episodes["gymfg/callsign"], frames.episodes["gymfg/spec"],
+                          strict=True) if not FlightSpec.from_json(s).is_solo
+    }  # fmt: skip
+    if team_runs:
+        raise ConfigError(
+            f"the dataset at {folder} holds team-run episodes ({', '.join(sorted(team_runs))} "
+            "flew beside other aircraft); a Minari dataset names one gymnasium env, which "
+            "flies one aircraft: export a solo dataset"
+        )
+    spec = env_spec(flight)
+    flown = _FlownActions(logs)
+    columns = frames.episodes
+    buffers = []
+    env = gym.make(spec)
+    try:
+        names = list(env.get_wrapper_attr("observation_names"))
+        if frames.observation_names != names:
+            raise ConfigError(
+                f"the dataset's observation names {frames.observation_names} are not those "
+                f"of its env {spec.id} ({names}); it cannot be exported with its env"
+            )
+        for i, episode in enumerate(columns["episode_index"]):
+            meta = {k: v[i] for k, v in columns.items()}
+            rows = frames.episode == episode
+            order = np.argsort(frames.frame[rows])
+            obs, labels = frames.obs[rows][order], frames.action[rows][order]
+            buffers.append(_refly(env, meta, obs, flown(meta, labels), labels))
+    finally:
+        env.close()
+    sources = sorted(set(columns.get("gymfg/source", [])))
+    with minari_root(root) as where, warnings.catch_warnings():
+        for what in ("code_permalink", "author", "author_email", "eval_env"):
+            warnings.filterwarnings("ignore", message=f"`{what}` is set to None")
+        try:
+            minari.create_dataset_from_buffers(
+                dataset_id=name,
+                buffer=buffers,
+                env=spec,
+                algorithm_name=", ".join(sources) or None,
+                description=(
+                    f"GymFG-IL demonstrations exported from the LeRobot dataset {folder.name}: "
+                    f"{flight.aircraft} flying {flight.task_label} at {flight.agent_hz} Hz "
+                    f"(JSBSim); observation names {', '.join(frames.observation_names)}; "
+                    "infos['label'] is the demonstrator's action"
+                ),
+                observation_space=env.observation_space,
+                action_space=env.action_space,
+                data_format=DATA_FORMAT,
+            )
+        except ValueError as err:
+            if "already exists" in str(err):
+                raise ConfigError(
+                    f"a Minari dataset {name} already exists under {where}: give another "
+                    "--name (or version) or delete it (minari.delete_dataset)"
+                ) from None
+            shutil.rmtree(where / name, ignore_errors=True)  # never half a dataset
+            raise
+        except BaseException:
+            shutil.rmtree(where / name, ignore_errors=True)
+            raise
+    steps = int(sum(len(b.rewards) for b in buffers))
+    return MinariSummary(name, where, len(buffers), steps, str(spec.id))
+
+
+def export_minari(cfg: MinariConfig) -> int:
+    """``collect export minari``: write the dataset and say how to open it."""
+    s = export_dataset(cfg.dataset, cfg.name, cfg.root)
+    print(
+        f"wrote Minari dataset {s.name} under {s.root}: {s.episodes} episodes, {s.steps} "
+        f"steps, env {s.env_id}\nopen it: MINARI_DATASETS_PATH={s.root} python -c "
+        f"\"import minari; print(minari.load_dataset('{s.name}'))\""
+    )
+    return 0
