@@ -146,6 +146,7 @@ def repair(folder: Path, sources: Sequence[Path]) -> int:
     """Restore the ``gymfg/*`` episode columns of the dataset at ``folder`` from ``sources``
     (``datasets.provenance.restore``)."""
     from gymfg_il.datasets import lerobot_api as lr
+    from gymfg_il.datasets.card import write_card
     from gymfg_il.datasets.provenance import metadata_columns, restore
 
     def dataset(path: Path) -> Path:
@@ -165,5 +166,6 @@ def repair(folder: Path, sources: Sequence[Path]) -> int:
             "editing drops them): give the dataset it was made from, --source ORIGINAL"
         )
     restored = restore(root, meta, [dataset(s) for s in sources])
+    write_card(root, str(meta.repo_id))  # the card reads them: tasks, sources, noise
     print(f"dataset {root}: restored the gymfg/* columns of {restored} episodes")
     return 0

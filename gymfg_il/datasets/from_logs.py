@@ -8,6 +8,7 @@ when it is complete, so a build that fails or is killed leaves the existing data
 from __future__ import annotations
 
 import gc
+import json
 import logging
 import math
 import shutil
@@ -58,9 +59,25 @@ def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarr
     }
 
 
+def target_record(task: dict[str, Any], target: float | None) -> dict[str, Any]:
+    """How an episode's target is kept: ``target`` the fixed target (NaN where it moves or
+    the task has none), ``target_kind`` static, dynamic or none, and for a moving target
+    ``target_plan`` (JSON): the variable, where the target starts, how it moves (waypoints
+    drawn from ``target_range`` every ``hold_s`` s, approached at ``rate`` units/s; offsets
+    from the start value when ``relative``). The schedule itself follows from the seed."""
+    if task.get("dynamic"):
+        keys = ("variable", "relative", "target_range", "fixed_target", "rate", "hold_s")
+        plan: dict[str, Any] = {"start": None if target is None else float(target)}
+        plan |= {k: task[k] for k in keys if k in task}
+        return {"target": math.nan, "target_kind": "dynamic", "target_plan": json.dumps(plan)}
+    if target is None:
+        return {"target": math.nan, "target_kind": "none", "target_plan": ""}
+    return {"target": float(target), "target_kind": "static", "target_plan": ""}
+
+
 def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[str, Any]:
     """The ``gymfg/*`` columns of one aircraft's episode: where it comes from and what was
-    flown (``spec``: the flight spec, JSON)."""
+    flown (``spec``: the flight spec, JSON; ``target``: ``target_record``)."""
     start, end = episode.start, episode.end or {}
     target = episode.start_of(callsign).get("target")
     info = log.aircraft(callsign)
@@ -70,7 +87,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "callsign": callsign,
         "team": str(info.get("team", "")),
         "task": str(task),
-        "target": float(target) if target is not None else math.nan,
+        **target_record(info.get("task", {}), target),
         "seed": int(start.get("seed", -1)),
         "source": str(start.get("source", log.session.get("source", ""))),
         "noise": float(log.session.get("noise", 0.0)),
@@ -80,6 +97,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "log": log.path.name,
         "log_episode": int(episode.index),
         "spec": log.spec.to_json(),
+        "jsbsim": str(log.session.get("versions", {}).get("jsbsim", "")),
     }
 
 
@@ -230,7 +248,7 @@ def _build(
                     )
                     added += 1
                     frames += len(columns["action"])
-        builder.finalize()
+        builder.finalize(card_root=root)
         total = builder.meta.total_episodes
     except BaseException:
         shutil.rmtree(work, ignore_errors=True)

@@ -188,3 +188,17 @@ def save_episode(
         episode_stats=stats,
         episode_metadata=metadata,
     )
+
+
+def dataset_card(meta: Any, description: str, tags: list[str]) -> str:
+    """The text of a dataset card made with LeRobot's own template (``card_template.md``,
+    through ``create_lerobot_dataset_card``): its YAML front matter, ``description`` and the
+    dataset's ``info.json``. No ``repo_id`` goes in: the template would link a Hub page the
+    local dataset does not have."""
+    check_version()
+    from lerobot.datasets.utils import create_lerobot_dataset_card
+
+    card = create_lerobot_dataset_card(
+        tags=tags, dataset_info=meta.info, dataset_description=description
+    )
+    return str(card)
