@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from gymfg_il.collectors.session import DATASET, LOGS
+from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs, dataset_refs, unrebuildable
 from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import EmptyLog, read_log
@@ -130,16 +131,47 @@ def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
 
 
 def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
-    """Rebuild ``folder/dataset`` from ``folder/logs`` (``callsigns``: only these aircraft)."""
+    """Rebuild ``folder/dataset`` from ``folder/logs`` (``callsigns``: only these aircraft);
+    1 when a log is damaged or an episode the dataset holds (or, of a DAgger session, its
+    base dataset held) cannot be rebuilt from the logs: each such episode is named."""
     logs = sorted((folder / LOGS).glob("*.mcap")) if folder.is_dir() else []
     if not logs:
         raise ConfigError(
             f"{folder} holds no {LOGS}/*.mcap: nothing to recover from (is it a "
             "collection session folder?)"
         )
-    report = build_from_logs(logs, folder / DATASET, callsigns=callsigns or None)
-    report_build(report, folder / DATASET)
-    return 1 if report.damage else 0  # the dataset holds all that could be read
+    root = folder / DATASET
+    # what the dataset should hold: its episodes as its table lists them (also when LeRobot
+    # cannot load it) and a DAgger session's base episodes
+    before = dataset_refs(root)
+    wanted = {ref: i for i, ref in [*base_refs([folder / LOGS]), *before] if ref is not None}
+    unnamed = [i for i, ref in before if ref is None]  # episodes that record no log
+    report = build_from_logs(logs, root, callsigns=callsigns or None)
+    report_build(report, root)
+    after = dataset_refs(root)
+    held = {ref for _, ref in after}
+    lost: list[tuple[int, EpisodeRef | None]] = [
+        (i, ref) for ref, i in wanted.items() if ref not in held
+    ]
+    if report.rebuilt:  # set aside: what it held that no log names is gone
+        lost += [(i, None) for i in unnamed]
+    kept = [(i, ref) for i, ref in after if ref is None or ref not in report.logged]
+    named = []
+    for title, rows in (
+        ("are lost: no log under {logs} holds them", lost),
+        ("are kept from the dataset as it was, but no log under {logs} holds them", kept),
+    ):
+        lines = unrebuildable(sorted(rows, key=lambda r: r[0]), report.logged, folder / LOGS)
+        if lines:
+            print(
+                f"{len(lines)} episode(s) " + title.format(logs=folder / LOGS) + ":",
+                file=sys.stderr,
+            )
+            for line in lines:
+                print(f"  {line}", file=sys.stderr)
+        named += lines
+    bad = bool(report.damage or named)
+    return 1 if bad else 0  # the dataset holds all that could be read
 
 
 def repair(folder: Path, sources: Sequence[Path]) -> int:

@@ -22,6 +22,7 @@ import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
+from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs
 from gymfg_il.datasets.features import dataset_features
 from gymfg_il.datasets.health import dataset_problems
 from gymfg_il.datasets.provenance import metadata_columns
@@ -43,6 +44,8 @@ class BuildReport:
     rebuilt: bool
     damage: list[str] = field(default_factory=list)  # "log: what was lost and why"
     skipped_empty: list[str] = field(default_factory=list)  # logs never written to
+    # the completed episodes of the logs a dataset may take (``episode_logs.unrebuildable``)
+    logged: set[EpisodeRef] = field(default_factory=set)
 
 
 def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarray]:
@@ -167,6 +170,8 @@ def build_from_logs(
 
     Episodes already in the dataset (by log file, episode and callsign) are kept; a dataset
     that cannot be read is set aside as ``<root>.broken-<time>`` and rebuilt from the logs.
+    Of a log a DAgger session linked in from its base dataset, only the base episodes are
+    taken, first and in the base dataset's order (``datasets.episode_logs``).
     """
     # The build allocates many short-lived objects and no cycles: keep the cyclic GC out.
     enabled = gc.isenabled()
@@ -197,6 +202,13 @@ def _build(
             empty.append(path.name)
     if not logs:
         raise ConfigError(f"no trajectory logs to build {root} from")
+    # a DAgger session's linked base logs: only the base episodes, first, in the base's order
+    base = [ref for _, ref in base_refs({p.parent for p in log_paths}) if ref is not None]
+    only: dict[str, set[tuple[int, str]]] = {}
+    for ref in base:
+        only.setdefault(ref.log, set()).add((ref.episode, ref.callsign))
+    rank = {name: i for i, name in enumerate(dict.fromkeys(ref.log for ref in base))}
+    logs.sort(key=lambda lg: (rank.get(lg.path.name, len(rank)), lg.path.name))
     chosen = _chosen(logs, callsigns)
     first_log, first = chosen[0]
     info = first_log.aircraft(first)
@@ -225,6 +237,7 @@ def _build(
             rebuilt = True
         present = set()
     added = frames = skipped = 0
+    logged: set[EpisodeRef] = set()
     try:
         builder = DatasetBuilder(work, repo_id, fps, features, robot_type=info["model"])
         for lg in logs:
@@ -233,6 +246,10 @@ def _build(
                 for callsign in episode.steps:  # in the order the flight lists them
                     if (lg.path, callsign) not in taken:
                         continue
+                    wanted = only.get(lg.path.name)
+                    if wanted is not None and (episode.index, callsign) not in wanted:
+                        continue
+                    logged.add(EpisodeRef(lg.path.name, episode.index, callsign))
                     if (lg.path.name, episode.index, callsign) in present:
                         continue
                     columns = episode_columns(episode, callsign)
@@ -263,4 +280,4 @@ def _build(
     _clean_leftovers(root)
     damage = [f"{lg.path.name}: {note}" for lg in logs for note in lg.damage]
     seconds = time.perf_counter() - started
-    return BuildReport(added, frames, skipped, total, seconds, rebuilt, damage, empty)
+    return BuildReport(added, frames, skipped, total, seconds, rebuilt, damage, empty, logged)
