@@ -40,9 +40,7 @@ def test_tasks_observing_different_variables_are_refused_even_with_the_flag(logs
     builder = DatasetBuilder(root, "gymfg/mix", 10, dataset_features(names))
     for lg in (altitude, roll):
         for ep in lg.complete_episodes:
-            builder.add_episode(
-                episode_columns(ep, "ego"), "fly", episode_metadata(lg, ep, "ego")
-            )
+            builder.add_episode(episode_columns(ep, "ego"), "fly", episode_metadata(lg, ep, "ego"))
     builder.finalize()
     for flag in (False, True):
         with pytest.raises(MixedTasksError) as err:
