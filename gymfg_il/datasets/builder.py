@@ -239,4 +239,4 @@ class DatasetBuilder:
         self.meta.finalize()
         from gymfg_il.datasets.card import write_card
 
-        write_card(self.root, self.repo_id, shown_root=card_root)
+        write_card(self.root, self.repo_id, shown_root=card_root, meta=self.meta)

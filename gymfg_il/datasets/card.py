@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from gymfg_il.datasets import lerobot_api as lr
-from gymfg_il.datasets.provenance import metadata_columns
+from gymfg_il.datasets.provenance import PREFIX
 from gymfg_il.sim.properties import ACTION_NAMES, BY_NAME
 
 CARD = "README.md"
@@ -67,11 +67,24 @@ def _counted(values: list[Any]) -> str:
     )
 
 
-def description(meta: Any, repo_id: str, root: Path) -> str:
-    """The card's description (Markdown) of the dataset whose metadata is ``meta``."""
+def episode_columns(root: Path) -> dict[str, list[Any]]:
+    """The ``gymfg/*`` columns of every episode, in file order, read with pyarrow alone
+    (LeRobot's loader of the episode table costs ~1 s on a 20-episode dataset)."""
+    import pyarrow.parquet as pq
+
+    out: dict[str, list[Any]] = {}
+    for path in sorted((Path(root) / "meta" / "episodes").rglob("*.parquet")):
+        names = [n for n in pq.read_schema(path).names if n.startswith(PREFIX)]
+        for name, column in pq.read_table(path, columns=names).to_pydict().items():
+            out.setdefault(name, []).extend(column)
+    return out
+
+
+def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: Path) -> str:
+    """The card's description (Markdown) of the dataset whose metadata is ``meta`` and whose
+    episodes' ``gymfg/*`` columns are ``episodes``."""
     from gymfg_il.envs.flight import FlightSpec
 
-    episodes = metadata_columns(meta)
     features = meta.features
     names = list(features["observation.state"]["names"] or [])
     specs = [FlightSpec.from_json(s) for s in sorted(set(episodes.get("gymfg/spec", [])))]
@@ -144,13 +157,17 @@ def description(meta: Any, repo_id: str, root: Path) -> str:
     return "\n".join(lines)
 
 
-def write_card(root: Path, repo_id: str = "gymfg/local", shown_root: Path | None = None) -> Path:
-    """Write (or rewrite) ``README.md`` of the dataset at ``root`` (``shown_root``: the
-    folder the loading example names, when the dataset is moved there); its path."""
+def write_card(
+    root: Path, repo_id: str = "gymfg/local", shown_root: Path | None = None, meta: Any = None
+) -> Path:
+    """Write (or rewrite) ``README.md`` of the dataset at ``root`` (``meta``: its finalised
+    metadata, else read; ``shown_root``: the folder the loading example names, when the
+    dataset is moved there); its path."""
     root = Path(root)
-    meta = lr.open_metadata(root, repo_id)  # afresh: a writer's copy lacks the new episodes
+    meta = meta if meta is not None else lr.open_metadata(root, repo_id)
+    episodes = episode_columns(root)
     tags = ["gymfg", "jsbsim", "simulation", "fixed-wing", "imitation-learning"]
-    text = lr.dataset_card(meta, description(meta, repo_id, shown_root or root), tags)
+    text = lr.dataset_card(meta, description(meta, episodes, repo_id, shown_root or root), tags)
     path = root / CARD
     tmp = path.with_name(f".{CARD}.tmp")
     tmp.write_text(text, encoding="utf-8")

@@ -55,10 +55,14 @@ def load() -> None:
     """Import the LeRobot modules used here (seconds, once per process), so that what is
     timed afterwards is the work, not the import."""
     check_version()
+    # jinja2 and huggingface_hub's repocard make the dataset card (``dataset_card``)
+    import huggingface_hub.repocard  # noqa: F401
+    import jinja2  # noqa: F401
     import lerobot.datasets.compute_stats
     import lerobot.datasets.dataset_metadata
     import lerobot.datasets.feature_utils
-    import lerobot.datasets.lerobot_dataset  # noqa: F401
+    import lerobot.datasets.lerobot_dataset
+    import lerobot.datasets.utils  # noqa: F401
 
 
 def open_metadata(root: Path, repo_id: str = "gymfg/local") -> Any:
