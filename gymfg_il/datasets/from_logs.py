@@ -208,7 +208,7 @@ def _build(
     for ref in base:
         only.setdefault(ref.log, set()).add((ref.episode, ref.callsign))
     rank = {name: i for i, name in enumerate(dict.fromkeys(ref.log for ref in base))}
-    logs.sort(key=lambda lg: (rank.get(lg.path.name, len(rank)), lg.path.name))
+    logs.sort(key=lambda lg: (rank.get(lg.path.name, len(rank)), str(lg.path)))
     chosen = _chosen(logs, callsigns)
     first_log, first = chosen[0]
     info = first_log.aircraft(first)
