@@ -18,7 +18,9 @@ from gymfg_il.recording.replay import replay_episode, world_for
 @dataclass
 class RecoverConfig:
     """Rebuild a session's dataset from its logs (after a crash or kill: keeps every
-    completed episode).
+    completed episode). Every episode the dataset holds, or held, that no log under logs/
+    can rebuild (its log deleted, or a DAgger session's base episodes without their linked
+    logs) is named, and the exit status is 1.
 
     Attributes:
         dir: the session folder (logs/ inside).
