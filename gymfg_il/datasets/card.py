@@ -88,9 +88,10 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
     features = meta.features
     names = list(features["observation.state"]["names"] or [])
     specs = [FlightSpec.from_json(s) for s in sorted(set(episodes.get("gymfg/spec", [])))]
-    jsbsim = sorted({str(v) for v in episodes.get("gymfg/jsbsim", []) if v}) or [
-        _installed("jsbsim")
-    ]
+    recorded = sorted({str(v) for v in episodes.get("gymfg/jsbsim", []) if v})
+    jsbsim = ", ".join(recorded) or (
+        f"version not recorded; {_installed('jsbsim')} where this card was written"
+    )
     sim_hz = sorted({s.sim_hz for s in specs})
     weather = sorted(
         {
@@ -103,7 +104,7 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
     kinds = episodes.get("gymfg/target_kind", [])
     aircraft = sorted(set(episodes.get("gymfg/aircraft", []))) or [str(meta.robot_type)]
     rows = [
-        ("data", f"simulated: the JSBSim flight dynamics model (JSBSim {', '.join(jsbsim)}); "
+        ("data", f"simulated: the JSBSim flight dynamics model (JSBSim {jsbsim}); "
          "no real aircraft flew"),
         ("aircraft", ", ".join(aircraft)),
         ("tasks", _counted(episodes.get("gymfg/task", [])) if episodes else "unknown"),
@@ -115,7 +116,7 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
         ("rates", f"{meta.fps} fps (agent steps); JSBSim at "
          f"{', '.join(str(h) for h in sim_hz) or 'unknown'} Hz"),
         ("episodes", f"{meta.total_episodes} ({meta.total_frames} frames)"),
-        ("recorded by", f"GymFG-IL {_installed('gymfg-il')}"),
+        ("card written by", f"GymFG-IL {_installed('gymfg-il')}"),
     ]  # fmt: skip
     lines = [
         "Fixed-wing flight demonstrations recorded with GymFG-IL: one frame per agent step, "
