@@ -116,6 +116,10 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
         ("rates", f"{meta.fps} fps (agent steps); JSBSim at "
          f"{', '.join(str(h) for h in sim_hz) or 'unknown'} Hz"),
         ("episodes", f"{meta.total_episodes} ({meta.total_frames} frames)"),
+        ("cameras", ", ".join(
+            f"`{k}` ({f['shape'][1]}x{f['shape'][0]} video)"
+            for k, f in features.items() if f.get("dtype") == "video"
+        ) or "none"),
         ("card written by", f"GymFG-IL {_installed('gymfg-il')}"),
     ]  # fmt: skip
     lines = [
