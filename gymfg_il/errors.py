@@ -36,3 +36,7 @@ def join_problems(what: str, problems: list[str]) -> str:
     if len(problems) == 1:
         return f"{what}: {problems[0]}"
     return f"{what} has {len(problems)} problems:\n" + "\n".join(f"  - {p}" for p in problems)
+
+
+class MixedTasksError(ConfigError):
+    """A dataset whose episodes were flown in different tasks, trained as if they were one."""

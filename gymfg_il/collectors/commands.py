@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from gymfg_il.collectors.session import DATASET, LOGS
+from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs, dataset_refs, unrebuildable
 from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import EmptyLog, read_log
@@ -18,7 +19,9 @@ from gymfg_il.recording.replay import replay_episode, world_for
 @dataclass
 class RecoverConfig:
     """Rebuild a session's dataset from its logs (after a crash or kill: keeps every
-    completed episode).
+    completed episode). Every episode the dataset holds, or held, that no log under logs/
+    can rebuild (its log deleted, or a DAgger session's base episodes without their linked
+    logs) is named, and the exit status is 1.
 
     Attributes:
         dir: the session folder (logs/ inside).
@@ -144,22 +147,54 @@ def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
 
 
 def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
-    """Rebuild ``folder/dataset`` from ``folder/logs`` (``callsigns``: only these aircraft)."""
+    """Rebuild ``folder/dataset`` from ``folder/logs`` (``callsigns``: only these aircraft);
+    1 when a log is damaged or an episode the dataset holds (or, of a DAgger session, its
+    base dataset held) cannot be rebuilt from the logs: each such episode is named."""
     logs = sorted((folder / LOGS).glob("*.mcap")) if folder.is_dir() else []
     if not logs:
         raise ConfigError(
             f"{folder} holds no {LOGS}/*.mcap: nothing to recover from (is it a "
             "collection session folder?)"
         )
-    report = build_from_logs(logs, folder / DATASET, callsigns=callsigns or None)
-    report_build(report, folder / DATASET)
-    return 1 if report.damage else 0  # the dataset holds all that could be read
+    root = folder / DATASET
+    # what the dataset should hold: its episodes as its table lists them (also when LeRobot
+    # cannot load it) and a DAgger session's base episodes
+    before = dataset_refs(root)
+    wanted = {ref: i for i, ref in [*base_refs([folder / LOGS]), *before] if ref is not None}
+    unnamed = [i for i, ref in before if ref is None]  # episodes that record no log
+    report = build_from_logs(logs, root, callsigns=callsigns or None)
+    report_build(report, root)
+    after = dataset_refs(root)
+    held = {ref for _, ref in after}
+    lost: list[tuple[int, EpisodeRef | None]] = [
+        (i, ref) for ref, i in wanted.items() if ref not in held
+    ]
+    if report.rebuilt:  # set aside: what it held that no log names is gone
+        lost += [(i, None) for i in unnamed]
+    kept = [(i, ref) for i, ref in after if ref is None or ref not in report.logged]
+    named = []
+    for title, rows in (
+        ("are lost: no log under {logs} holds them", lost),
+        ("are kept from the dataset as it was, but no log under {logs} holds them", kept),
+    ):
+        lines = unrebuildable(sorted(rows, key=lambda r: r[0]), report.logged, folder / LOGS)
+        if lines:
+            print(
+                f"{len(lines)} episode(s) " + title.format(logs=folder / LOGS) + ":",
+                file=sys.stderr,
+            )
+            for line in lines:
+                print(f"  {line}", file=sys.stderr)
+        named += lines
+    bad = bool(report.damage or named)
+    return 1 if bad else 0  # the dataset holds all that could be read
 
 
 def repair(folder: Path, sources: Sequence[Path]) -> int:
     """Restore the ``gymfg/*`` episode columns of the dataset at ``folder`` from ``sources``
     (``datasets.provenance.restore``)."""
     from gymfg_il.datasets import lerobot_api as lr
+    from gymfg_il.datasets.card import write_card
     from gymfg_il.datasets.provenance import metadata_columns, restore
 
     def dataset(path: Path) -> Path:
@@ -179,6 +214,7 @@ def repair(folder: Path, sources: Sequence[Path]) -> int:
             "editing drops them): give the dataset it was made from, --source ORIGINAL"
         )
     restored = restore(root, meta, [dataset(s) for s in sources])
+    write_card(root, str(meta.repo_id))  # the card reads them: tasks, sources, noise
     print(f"dataset {root}: restored the gymfg/* columns of {restored} episodes")
     return 0
 

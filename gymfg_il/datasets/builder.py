@@ -11,6 +11,7 @@ parity test checks it against LeRobot's own writer.
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,8 @@ from gymfg_il.datasets.features import ENVIRONMENT_STATE, check_compatible
 from gymfg_il.datasets.videos import VideoTrack
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import task_columns
+
+log = logging.getLogger(__name__)
 
 
 class DatasetBuilder:
@@ -62,6 +65,15 @@ class DatasetBuilder:
                 root.rmdir()
             meta = lr.create_metadata(root, repo_id, fps, features, robot_type)
         self.meta = meta
+        self.repo_id = repo_id
+        # LeRobot loads meta/episodes only when every file has the same columns: episodes
+        # appended to a dataset carry the gymfg/* columns its episodes have, no others (an
+        # older dataset lacks the newer ones; LeRobot's editing drops them all)
+        self._episode_columns: set[str] | None = None
+        if meta.episodes is not None and len(meta.episodes) > 0:
+            self._episode_columns = {
+                c for c in meta.episodes.column_names if c.startswith("gymfg/")
+            }
         # the environment state is drawn from the observation (absent in older datasets)
         self._environment: list[int] | None = None
         if ENVIRONMENT_STATE in meta.features:
@@ -192,14 +204,30 @@ class DatasetBuilder:
             "dataset_from_index": start,
             "dataset_to_index": start + n,
             **videos,
-            **{f"gymfg/{k}": v for k, v in (metadata or {}).items()},
+            **self._episode_metadata(metadata or {}),
         }
         lr.save_episode(meta, index, n, task, stats, episode_meta)
         return index
 
-    def finalize(self) -> None:
+    def _episode_metadata(self, metadata: dict[str, Any]) -> dict[str, Any]:
+        """The ``gymfg/*`` columns of a new episode, as many as the dataset's episodes have."""
+        columns = {f"gymfg/{k}": v for k, v in metadata.items()}
+        if self._episode_columns is None:
+            return columns
+        dropped = sorted(set(columns) - self._episode_columns)
+        if dropped:
+            log.info(
+                "%s: the new episodes leave out %s, which its older episodes lack",
+                self.root,
+                ", ".join(dropped),
+            )
+        return {k: v for k, v in columns.items() if k in self._episode_columns}
+
+    def finalize(self, card_root: Path | None = None) -> None:
         """Close the data file and flush LeRobot's buffered episode table (mandatory: before
-        it the dataset is incomplete)."""
+        it the dataset is incomplete), then write the dataset card (``datasets.card``;
+        ``card_root``: where the dataset will live, for the card's loading example, when it is
+        built elsewhere and moved)."""
         if self._writer is not None:
             self._writer.close()
             self._writer = None
@@ -209,3 +237,6 @@ class DatasetBuilder:
         for key in tracks:
             lr.record_video_info(self.meta, key, lr.video_encoder())
         self.meta.finalize()
+        from gymfg_il.datasets.card import write_card
+
+        write_card(self.root, self.repo_id, shown_root=card_root, meta=self.meta)

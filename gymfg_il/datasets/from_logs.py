@@ -8,6 +8,7 @@ when it is complete, so a build that fails or is killed leaves the existing data
 from __future__ import annotations
 
 import gc
+import json
 import logging
 import math
 import shutil
@@ -21,6 +22,7 @@ import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
+from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs
 from gymfg_il.datasets.features import dataset_features
 from gymfg_il.datasets.health import dataset_problems
 from gymfg_il.datasets.provenance import metadata_columns
@@ -42,6 +44,8 @@ class BuildReport:
     rebuilt: bool
     damage: list[str] = field(default_factory=list)  # "log: what was lost and why"
     skipped_empty: list[str] = field(default_factory=list)  # logs never written to
+    # the completed episodes of the logs a dataset may take (``episode_logs.unrebuildable``)
+    logged: set[EpisodeRef] = field(default_factory=set)
 
 
 def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarray]:
@@ -58,9 +62,25 @@ def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarr
     }
 
 
+def target_record(task: dict[str, Any], target: float | None) -> dict[str, Any]:
+    """How an episode's target is kept: ``target`` the fixed target (NaN where it moves or
+    the task has none), ``target_kind`` static, dynamic or none, and for a moving target
+    ``target_plan`` (JSON): the variable, where the target starts, how it moves (waypoints
+    drawn from ``target_range`` every ``hold_s`` s, approached at ``rate`` units/s; offsets
+    from the start value when ``relative``). The schedule itself follows from the seed."""
+    if task.get("dynamic"):
+        keys = ("variable", "relative", "target_range", "fixed_target", "rate", "hold_s")
+        plan: dict[str, Any] = {"start": None if target is None else float(target)}
+        plan |= {k: task[k] for k in keys if k in task}
+        return {"target": math.nan, "target_kind": "dynamic", "target_plan": json.dumps(plan)}
+    if target is None:
+        return {"target": math.nan, "target_kind": "none", "target_plan": ""}
+    return {"target": float(target), "target_kind": "static", "target_plan": ""}
+
+
 def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[str, Any]:
     """The ``gymfg/*`` columns of one aircraft's episode: where it comes from and what was
-    flown (``spec``: the flight spec, JSON)."""
+    flown (``spec``: the flight spec, JSON; ``target``: ``target_record``)."""
     start, end = episode.start, episode.end or {}
     target = episode.start_of(callsign).get("target")
     info = log.aircraft(callsign)
@@ -70,7 +90,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "callsign": callsign,
         "team": str(info.get("team", "")),
         "task": str(task),
-        "target": float(target) if target is not None else math.nan,
+        **target_record(info.get("task", {}), target),
         "seed": int(start.get("seed", -1)),
         "source": str(start.get("source", log.session.get("source", ""))),
         "noise": float(log.session.get("noise", 0.0)),
@@ -80,6 +100,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "log": log.path.name,
         "log_episode": int(episode.index),
         "spec": log.spec.to_json(),
+        "jsbsim": str(log.session.get("versions", {}).get("jsbsim", "")),
     }
 
 
@@ -149,6 +170,8 @@ def build_from_logs(
 
     Episodes already in the dataset (by log file, episode and callsign) are kept; a dataset
     that cannot be read is set aside as ``<root>.broken-<time>`` and rebuilt from the logs.
+    Of a log a DAgger session linked in from its base dataset, only the base episodes are
+    taken, first and in the base dataset's order (``datasets.episode_logs``).
     """
     # The build allocates many short-lived objects and no cycles: keep the cyclic GC out.
     enabled = gc.isenabled()
@@ -179,6 +202,13 @@ def _build(
             empty.append(path.name)
     if not logs:
         raise ConfigError(f"no trajectory logs to build {root} from")
+    # a DAgger session's linked base logs: only the base episodes, first, in the base's order
+    base = [ref for _, ref in base_refs({p.parent for p in log_paths}) if ref is not None]
+    only: dict[str, set[tuple[int, str]]] = {}
+    for ref in base:
+        only.setdefault(ref.log, set()).add((ref.episode, ref.callsign))
+    rank = {name: i for i, name in enumerate(dict.fromkeys(ref.log for ref in base))}
+    logs.sort(key=lambda lg: (rank.get(lg.path.name, len(rank)), str(lg.path)))
     chosen = _chosen(logs, callsigns)
     first_log, first = chosen[0]
     info = first_log.aircraft(first)
@@ -207,6 +237,7 @@ def _build(
             rebuilt = True
         present = set()
     added = frames = skipped = 0
+    logged: set[EpisodeRef] = set()
     try:
         builder = DatasetBuilder(work, repo_id, fps, features, robot_type=info["model"])
         for lg in logs:
@@ -215,6 +246,10 @@ def _build(
                 for callsign in episode.steps:  # in the order the flight lists them
                     if (lg.path, callsign) not in taken:
                         continue
+                    wanted = only.get(lg.path.name)
+                    if wanted is not None and (episode.index, callsign) not in wanted:
+                        continue
+                    logged.add(EpisodeRef(lg.path.name, episode.index, callsign))
                     if (lg.path.name, episode.index, callsign) in present:
                         continue
                     columns = episode_columns(episode, callsign)
@@ -230,7 +265,7 @@ def _build(
                     )
                     added += 1
                     frames += len(columns["action"])
-        builder.finalize()
+        builder.finalize(card_root=root)
         total = builder.meta.total_episodes
     except BaseException:
         shutil.rmtree(work, ignore_errors=True)
@@ -245,4 +280,4 @@ def _build(
     _clean_leftovers(root)
     damage = [f"{lg.path.name}: {note}" for lg in logs for note in lg.damage]
     seconds = time.perf_counter() - started
-    return BuildReport(added, frames, skipped, total, seconds, rebuilt, damage, empty)
+    return BuildReport(added, frames, skipped, total, seconds, rebuilt, damage, empty, logged)

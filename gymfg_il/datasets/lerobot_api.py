@@ -55,10 +55,14 @@ def load() -> None:
     """Import the LeRobot modules used here (seconds, once per process), so that what is
     timed afterwards is the work, not the import."""
     check_version()
+    # jinja2 and huggingface_hub's repocard make the dataset card (``dataset_card``)
+    import huggingface_hub.repocard  # noqa: F401
+    import jinja2  # noqa: F401
     import lerobot.datasets.compute_stats
     import lerobot.datasets.dataset_metadata
     import lerobot.datasets.feature_utils
-    import lerobot.datasets.lerobot_dataset  # noqa: F401
+    import lerobot.datasets.lerobot_dataset
+    import lerobot.datasets.utils  # noqa: F401
 
 
 def open_metadata(root: Path, repo_id: str = "gymfg/local") -> Any:
@@ -188,3 +192,17 @@ def save_episode(
         episode_stats=stats,
         episode_metadata=metadata,
     )
+
+
+def dataset_card(meta: Any, description: str, tags: list[str]) -> str:
+    """The text of a dataset card made with LeRobot's own template (``card_template.md``,
+    through ``create_lerobot_dataset_card``): its YAML front matter, ``description`` and the
+    dataset's ``info.json``. No ``repo_id`` goes in: the template would link a Hub page the
+    local dataset does not have."""
+    check_version()
+    from lerobot.datasets.utils import create_lerobot_dataset_card
+
+    card = create_lerobot_dataset_card(
+        tags=tags, dataset_info=meta.info, dataset_description=description
+    )
+    return str(card)

@@ -58,6 +58,10 @@ class TrainConfig:
             before; two show the rates).
         obs_noise: std of Gaussian noise added to the normalised observations while training
             (0 = none).
+        mixed_tasks: train one policy on episodes of different tasks that observe the same
+            variables (altitude with altitude-dynamic, say). Without it a dataset of several
+            tasks is refused, naming each task's episodes; tasks that observe different
+            variables are refused either way.
         threads: CPU threads torch uses on cpu (0 = torch's own choice; default: 1, or 0 for
             a vision policy). One is fastest for the small policies: the default MLP trained
             3x faster on 1 thread than on 2; the vision policy's convolutions 1.7x faster on 2.
@@ -80,6 +84,7 @@ class TrainConfig:
     camera: Literal["front", "chase"] = "front"
     frames: int = 2
     obs_noise: float = 0.0
+    mixed_tasks: bool = False
     threads: int | None = None
 
     def __post_init__(self) -> None:
@@ -197,13 +202,14 @@ def _train(
 ) -> TrainResult:
     import torch
 
-    from gymfg_il.learning.data import TensorBatches, load_frames, split_by_episode
+    from gymfg_il.learning.data import TensorBatches, check_tasks, load_frames, split_by_episode
     from gymfg_il.policies.factory import make_config, make_policy, save_policy
 
     device = resolve_device(cfg.device)
     camera = cfg.camera if cfg.policy == "vision" else None
     if frames is None or (camera is not None and frames.camera != camera):
         frames = load_frames(cfg.dataset, camera)
+    check_tasks(frames.episodes, cfg.mixed_tasks)
     shown = frames.demonstrated()  # of a policy's own flying, only a person's takeovers
     if len(shown) < len(frames):
         log.info(

@@ -1,9 +1,12 @@
 """DAgger: the policy flies, the expert (the task's controller) labels every state the policy
 visits, the labelled episodes join the dataset (source ``dagger`` and the iteration are
-recorded per episode), and the policy is trained again on the aggregate."""
+recorded per episode), and the policy is trained again on the aggregate. The session starts
+from a copy of the policy's dataset and links those episodes' logs into its ``logs/``
+(``datasets.episode_logs``), so `collect recover` rebuilds every episode of the aggregate."""
 
 from __future__ import annotations
 
+import logging
 import shutil
 from collections.abc import Callable
 from dataclasses import dataclass, fields
@@ -12,11 +15,14 @@ from typing import Any, Literal
 
 from gymfg_il.collectors.session import DATASET, LOGS, record_session
 from gymfg_il.datasets import lerobot_api as lr
+from gymfg_il.datasets.episode_logs import link_base_logs
 from gymfg_il.datasets.videos import IMAGE_PREFIX
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.workers import Workers
+
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -111,7 +117,18 @@ def run_dagger(
         if not (base / "meta" / "info.json").is_file():
             raise ConfigError(f"the policy's dataset {base} is gone; DAgger aggregates onto it")
         out.mkdir(parents=True, exist_ok=True)
+        # the base episodes' logs come along, so `collect recover` rebuilds every episode
+        unlinked = link_base_logs(base, out / LOGS)
         shutil.copytree(base, root)
+        if unlinked:
+            log.warning(
+                "%d episode(s) of %s have no log to take along; `collect recover %s` cannot "
+                "rebuild them: %s",
+                len(unlinked),
+                base,
+                out,
+                "; ".join(unlinked[:5]),
+            )
     # a camera dataset stays one: the new rounds draw the same views at the same size
     root_meta = lr.open_metadata(root)
     cameras = root_meta.video_keys

@@ -19,7 +19,7 @@ from gymfg_il.datasets.health import dataset_problems
 from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.videos import decode_camera, image_key
 from gymfg_il.envs.flight import FlightSpec
-from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.errors import ConfigError, MixedTasksError, join_problems
 
 
 @dataclass
@@ -104,6 +104,69 @@ def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
             "options or rate)"
         )
     return alike.pop(), ""
+
+
+def _observed(spec: str, callsign: str) -> tuple[str, ...] | None:
+    """The observation names of ``callsign``'s task in the flight ``spec`` (JSON)."""
+    try:
+        aircraft = FlightSpec.from_json(spec).for_callsign(callsign).solo_aircraft
+        return tuple(aircraft.task_factory()().observation_names)
+    except (ConfigError, ValueError, KeyError, TypeError):
+        return None  # a spec this version cannot build: its names are unknown
+
+
+def check_tasks(episodes: dict[str, list[Any]], mixed_tasks: bool = False) -> None:
+    """Refuse (``MixedTasksError``, naming the episodes of each task) a dataset whose episodes
+    (``gymfg/*`` columns) were flown in different tasks: ``observation.state[k]`` would mean
+    one variable in some episodes and another in the rest, or the same inputs would ask for
+    different behaviours. ``mixed_tasks`` trains one policy across tasks on purpose, allowed
+    only where every task observes the same names (altitude with altitude-dynamic, say).
+    Datasets without the columns (older, or edited by LeRobot's tools) are not checked."""
+    tasks = episodes.get("gymfg/task")
+    if not tasks:
+        return
+    ids = episodes.get("episode_index") or list(range(len(tasks)))
+    specs = episodes.get("gymfg/spec") or [None] * len(tasks)
+    callsigns = episodes.get("gymfg/callsign") or ["ego"] * len(tasks)
+    cache: dict[tuple[str, str], tuple[str, ...] | None] = {}
+    groups: dict[tuple[str, tuple[str, ...] | None], list[int]] = {}
+    for index, task, spec, callsign in zip(ids, tasks, specs, callsigns, strict=True):
+        key = (str(spec), str(callsign))
+        if key not in cache:
+            cache[key] = _observed(spec, callsign) if spec else None
+        groups.setdefault((str(task), cache[key]), []).append(int(index))
+    names = {n for _, n in groups if n is not None}
+    if len({t for t, _ in groups}) <= 1 and len(names) <= 1:
+        return
+    if len(names) <= 1 and mixed_tasks:
+        return
+
+    def episodes_text(ids: list[int]) -> str:
+        shown = ", ".join(str(i) for i in ids[:10])
+        return shown + (f", ... ({len(ids)} in all)" if len(ids) > 10 else "")
+
+    lines = []
+    for (task, observed), members in sorted(groups.items(), key=lambda g: g[1][0]):
+        what = "observation unknown" if observed is None else f"observes {', '.join(observed)}"
+        lines.append(f"task {task!r} ({what}): episodes {episodes_text(members)}")
+    if len(names) > 1:
+        raise MixedTasksError(
+            join_problems(
+                "the dataset's episodes come from tasks that observe different variables "
+                "(the same observation.state column means another variable in each group); "
+                "train on one task's episodes: collect or rebuild one dataset per task "
+                "(--mixed-tasks cannot help: it needs the same observation names)",
+                lines,
+            )
+        )
+    raise MixedTasksError(
+        join_problems(
+            "the dataset's episodes come from different tasks; pass --mixed-tasks to train "
+            "one policy across them on purpose (they observe the same variables), or train "
+            "on one task's episodes",
+            lines,
+        )
+    )
 
 
 def dataset_flight(root: Path) -> tuple[FlightSpec | None, str, dict[str, Any]]:

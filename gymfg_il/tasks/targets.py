@@ -228,4 +228,6 @@ class TargetTask(Task):
             "target_range": list(self.target_range),
             "fixed_target": self.fixed_target,
             "tolerance": self.tolerance,
+            # how a moving target moves (datasets record it as the episode's target plan)
+            **({"rate": fam.rate, "hold_s": self.hold_s} if self.dynamic else {}),
         }

@@ -52,6 +52,8 @@ def test_stock_lerobot_decodes_the_frames_the_camera_draws(camera_dataset):
     stats = ds.meta.stats["observation.images.front"]
     assert np.asarray(stats["mean"]).shape == (3, 1, 1)
     assert 0.2 < float(np.asarray(stats["mean"]).mean()) < 0.9
+    card = (out / "dataset" / "README.md").read_text()
+    assert "`observation.images.front` (128x128 video)" in card
 
 
 def test_a_state_only_session_cannot_join_a_camera_dataset(camera_dataset):

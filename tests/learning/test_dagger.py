@@ -76,3 +76,50 @@ def test_dagger_flies_the_policys_own_flight(tmp_path):
     assert log.aircraft("ego")["task"]["tolerance"] == 20.0
     retrained = AgentSpec.policy(history[-1].policy).meta()
     assert FlightSpec.from_dict(retrained["spec"]) == demo.flight()
+
+
+def test_recover_rebuilds_every_episode_of_a_dagger_session_and_names_what_it_cannot(
+    tmp_path, capsys
+):
+    import json
+    import os
+    import shutil
+
+    from gymfg_il import collect
+    from gymfg_il.datasets import lerobot_api as lr
+    from gymfg_il.datasets.episode_logs import dataset_refs
+
+    demo = CollectConfig(task="altitude", episodes=3, episode_time_s=3, out=tmp_path / "demo")
+    (base_log,) = [record_autopilot(demo).log]
+    build_from_logs([base_log], tmp_path / "demo" / "dataset")
+    bc = train_bc(TrainConfig(dataset=tmp_path / "demo" / "dataset", out=tmp_path / "bc", epochs=1))
+    session = tmp_path / "dagger"
+    run_dagger(bc.out, session, iterations=1, episodes=2, train_overrides={"epochs": 1})
+    linked = session / "logs" / base_log.name
+    assert os.path.samefile(linked, base_log)  # a hard link, not a second copy
+    record = json.loads((session / "logs" / "base-episodes.json").read_text())
+    assert [e["log_episode"] for e in record["episodes"]] == [0, 1, 2]
+
+    def summary(root):
+        meta = lr.open_metadata(root)
+        return meta.total_episodes, meta.total_frames, list(meta.episodes["length"])
+
+    made, made_refs = summary(session / "dataset"), dataset_refs(session / "dataset")
+    assert made[0] == 5  # 3 base + 2 DAgger episodes
+    shutil.move(session / "dataset", tmp_path / "made")
+    assert collect.main(["recover", str(session)]) == 0
+    assert summary(session / "dataset") == made  # every episode, in the same order
+    assert dataset_refs(session / "dataset") == made_refs
+
+    linked.unlink()  # the base log gone: recover names each episode it held
+    capsys.readouterr()
+    assert collect.main(["recover", str(session)]) == 1
+    err = capsys.readouterr().err
+    assert "3 episode(s) are kept from the dataset as it was, but no log" in err
+    for k in range(3):
+        assert f"dataset episode {k}: {base_log.name} episode {k} (ego): log missing" in err
+    shutil.rmtree(session / "dataset")
+    assert collect.main(["recover", str(session)]) == 1
+    err = capsys.readouterr().err
+    assert "3 episode(s) are lost" in err and f"{base_log.name} episode 2 (ego)" in err
+    assert summary(session / "dataset")[0] == 2  # the DAgger episodes alone
