@@ -19,7 +19,12 @@ from gymfg_il.typecheck import type_problems
 DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
 EPOCHS_AUTOPILOT, EPOCHS_PERSON = 60, 20  # the default epochs (TrainConfig.epochs)
 EPOCHS_VISION = 20  # a vision policy's validation loss stops falling by then, at ~25 s each
-OVERFIT_RATIO = 2.0  # validation over training loss above which train says the policy memorised
+# validation over training loss above which train says the policy memorised. Measured on roll
+# (c172p, 20 demonstrations, trimmed starts): without noise 35x, and the policy crashed in 14 of
+# 16 held-out episodes; with the default noise 10x (one held-out episode's elevator and throttle,
+# which follow integrals the task does not observe) and 16 of 16 succeeded. Good default
+# policies measured 1.6-10x, memorised ones 35-36x.
+OVERFIT_RATIO = 20.0
 log = logging.getLogger(__name__)
 
 

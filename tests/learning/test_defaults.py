@@ -38,5 +38,9 @@ def test_train_says_when_validation_loss_is_far_above_training_loss(tmp_path):
 
     warning = result(0.0006, 0.0216).overfit  # the memorised roll policy
     assert "36.0x" in warning and "--noise" in warning
+    assert "35.6x" in result(0.0008, 0.0285).overfit  # the same from trimmed starts, no noise
     assert result(0.020, 0.021).overfit == ""  # a policy that generalises
+    # default noise from trimmed starts: one held-out episode's throttle and elevator follow
+    # integrals the task does not observe, yet the policy flew 16 of 16 held-out episodes
+    assert result(0.0255, 0.2587).overfit == ""
     assert result(0.0001, 0.0004).overfit == ""  # both tiny: nothing worth a warning
