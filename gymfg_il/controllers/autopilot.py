@@ -118,6 +118,7 @@ class Autopilot:
         self._last_heading_target: float | None = None
         self._last_altitude_target: float | None = None
         self.throttle_trim = 0.7
+        self.rudder_trim = 0.0
         self._observed = self._observed_integrals()
         self._from_observation: dict[str, int] = {}
 
@@ -126,6 +127,8 @@ class Autopilot:
             pid.reset()
         self._from_observation = {}
         self.start = None
+        # centred surfaces until start_from says what the aircraft starts with
+        self.roll_pid.bias = self.pitch_pid.bias = self.slip_pid.bias = self.rudder_trim = 0.0
         self._last_heading_target = None
         self._last_altitude_target = None
 
@@ -172,7 +175,11 @@ class Autopilot:
         self.throttle_trim = throttle
 
     def start_from(self, action: np.ndarray) -> None:
-        """Start this episode from the aircraft's start controls (its trimmed throttle)."""
+        """Start this episode from the aircraft's start controls (a trimmed start's trim):
+        each surface loop and the throttle loop output them while their errors are zero."""
+        self.roll_pid.bias = float(action[0])
+        self.pitch_pid.bias = -float(action[1])  # positive elevator = nose down
+        self.slip_pid.bias = self.rudder_trim = float(action[2])
         self.throttle_trim = float(action[3])
 
     def _value(
@@ -247,7 +254,7 @@ class Autopilot:
         self._load_integral("speed", self.speed_pid, obs, speed_target - obs[i["airspeed_kts"]])
         throttle = self.speed_pid(speed_target, obs[i["airspeed_kts"]], dt)
         if t.sideslip_source is None:  # coordinated flight: sideslip to zero
-            rudder = max(-1.0, min(1.0, -g.sideslip * obs[i["beta_deg"]]))
+            rudder = max(-1.0, min(1.0, self.rudder_trim - g.sideslip * obs[i["beta_deg"]]))
         else:  # a slip: rudder to the sideslip target (more rudder, more sideslip)
             slip_target = self._value(obs, t.sideslip_source, "beta_deg")
             rudder = self.slip_pid(slip_target, obs[i["beta_deg"]], dt)

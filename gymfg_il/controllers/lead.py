@@ -48,8 +48,7 @@ class LeadPilot:
         pilot.set_throttle_trim(throttle)
         sim = self.sim
         state = sim.reset(ic, throttle)
-        if sim.trim is not None:
-            pilot.set_throttle_trim(sim.trim.throttle)
+        pilot.start_from(np.array(sim.start_action))
         track = np.empty((len(altitude_targets), len(view)))
         for i in range(len(altitude_targets)):
             track[i] = state[view]

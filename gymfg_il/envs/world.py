@@ -225,10 +225,9 @@ class World:
                 slot.state = slot.prev_state = slot.sim.reset(ic, throttle, air)
             except ConfigError as err:  # an untrimmable start: say whose
                 raise ConfigError(f"{slot.callsign} ({slot.aircraft.model}): {err}") from None
-            if slot.sim.trim is not None:  # a trimmed start flies off at the trim's throttle
-                throttle = slot.sim.trim.throttle
             slot.task.reset(slot.state, own)
-            slot.action = slot.prev_action = np.array([0.0, 0.0, 0.0, throttle])
+            # the controls it starts with: a trimmed start's trim values (hands-off flight)
+            slot.action = slot.prev_action = np.array(slot.sim.start_action)
             slot.reward = 0.0
             slot.terminated = False
             slot.reason = None

@@ -96,6 +96,8 @@ class Simulation:
             node(f"fcs/{axis}-trim-cmd-norm").set_double_value for axis in ("pitch", "roll", "yaw")
         ]
         self.trim: Trim | None = None  # the last reset's trim (None: an untrimmed start)
+        # the controls the last reset started with: the trim's, or centred with its throttle
+        self.start_action: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
         self.resets = 0
         if self._retracts:
             self._retract_gear()
@@ -110,15 +112,17 @@ class Simulation:
     ) -> np.ndarray:
         """Put the aircraft in ``ic`` with engines running, in ``air`` (calm by default);
         return the first state vector. A trimmed ``ic`` (``trimmed=True``) starts at the trim's
-        pitch, with its pitch, roll and yaw trim set and its throttle instead of
-        ``throttle``; ``self.trim`` then holds it."""
+        pitch with the controls at the trim's values (``self.start_action``; ``self.trim``
+        holds the trim); an untrimmed one with the surfaces centred and ``throttle``."""
         air = air or CALM
         trim = None
+        controls = (0.0, 0.0, 0.0, throttle)
         if ic.trimmed:
             trim = trim_for(self.model, ic.altitude_ft, ic.airspeed_kts, self.sim_hz)
             ic = dataclasses.replace(ic, pitch_deg=trim.pitch_deg, trimmed=False)
-            throttle = trim.throttle
+            controls = (trim.aileron, trim.elevator, trim.rudder, trim.throttle)
         self.trim = trim
+        self.start_action = controls
         xml = ic.to_xml(air.wind).replace("</initialize>", " <running>-1</running>\n</initialize>")
         fdm = self.fdm
         # JSBSim reads initial conditions only from a file. It lives just for the load, so
@@ -133,14 +137,15 @@ class Simulation:
         air.before_reset(fdm)
         for prop in self._mixtures:
             fdm[prop] = 1.0
-        self.apply(0.0, 0.0, 0.0, throttle, run=False)
+        self.apply(*controls, run=False)
         if self._has_gear:
             fdm["gear/gear-cmd-norm"] = 0.0
         fdm.reset_to_initial_conditions(0)
-        # after the reset, which zeroes JSBSim's trim commands
-        trims = (trim.elevator, trim.aileron, trim.rudder) if trim else (0.0, 0.0, 0.0)
-        for set_trim, value in zip(self._set_trims, trims, strict=True):
-            set_trim(value)
+        # the trim lives in the controls, never in JSBSim's trim commands: an action is then
+        # the whole command, a function of the state the aircraft is in (with the trim in
+        # fcs/*-trim-cmd-norm a label would depend on where the episode started)
+        for set_trim in self._set_trims:
+            set_trim(0.0)
         self.resets += 1
         return self.read()
 

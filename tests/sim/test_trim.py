@@ -18,12 +18,12 @@ from gymfg_il.sim.trim import trim_for
 
 def _hands_off(sim: Simulation, seconds: float = 5.0) -> tuple[float, float]:
     """Worst altitude change (ft) and pitch rate (rad/s), at the agent rate, flying the
-    trim's controls (zero stick, the trim's throttle)."""
+    trim's controls (the start action: the trim's surfaces and throttle)."""
     assert sim.trim is not None
     fdm = sim.fdm
     h0, worst_h, worst_q = fdm["position/h-sl-ft"], 0.0, 0.0
     for _ in range(round(seconds * sim.agent_hz)):
-        sim.apply(0.0, 0.0, 0.0, sim.trim.throttle)
+        sim.apply(*sim.start_action)
         worst_h = max(worst_h, abs(fdm["position/h-sl-ft"] - h0))
         worst_q = max(worst_q, abs(fdm["velocities/q-rad_sec"]))
     return worst_h, worst_q
