@@ -219,7 +219,12 @@ def _fly_by_hand(cfg: object, show_progress: bool = True) -> int:
         cfg.flight(),
         cfg.out,
         cfg.device,
-        {"keyboard": cfg.keyboard, "mouse": cfg.mouse, "joystick": cfg.joystick},
+        {
+            "keyboard": cfg.keyboard,
+            "mouse": cfg.mouse,
+            "joystick": cfg.joystick,
+            "flightgear": cfg.flightgear,
+        },
         cfg.assist,
         cfg.seed,
         cfg.episodes,
