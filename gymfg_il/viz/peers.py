@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.viz.multiplayer import (
+    FG_D2R,
     HEADER,
     MAGIC,
     POSITION_MESSAGE,
@@ -47,6 +48,7 @@ _A = 6378137.0  # WGS84
 _E2 = (1 / 298.257223563) * (2 - 1 / 298.257223563)
 _FT = 0.3048
 _R2D = 180.0 / math.pi
+_FG_R2D = 1.0 / FG_D2R
 
 
 class MessageError(ValueError):
@@ -106,7 +108,8 @@ class Peer:
 
 
 def geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
-    """WGS84 latitude, longitude (degrees) and altitude (ft) of an ECEF position (m)."""
+    """WGS84 latitude, longitude (degrees) and altitude (ft) of an ECEF position (m), with
+    FlightGear's degree constant (``multiplayer.FG_D2R``)."""
     lon = math.atan2(y, x)
     p = math.hypot(x, y)
     lat = math.atan2(z, p * (1.0 - _E2))
@@ -116,7 +119,7 @@ def geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
         n = _A / math.sqrt(1.0 - _E2 * s * s)
         h = p / math.cos(lat) - n
         lat = math.atan2(z, p * (1.0 - _E2 * n / (n + h)))
-    return lat * _R2D, lon * _R2D, h / _FT
+    return lat * _FG_R2D, lon * _FG_R2D, h / _FT
 
 
 def attitude(
