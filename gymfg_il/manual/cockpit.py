@@ -66,6 +66,7 @@ class CockpitReceiver:
         self.sock.setblocking(False)
         self.received = self.rejected = 0
         self.last_heard = -np.inf
+        self.latest: np.ndarray | None = None  # the controls as FlightGear last sent them
 
     def poll(self) -> np.ndarray | None:
         """The newest controls that arrived since the last poll, or None."""
@@ -86,6 +87,7 @@ class CockpitReceiver:
             return None
         self.received += 1
         self.last_heard = self.clock()
+        self.latest = values
         return values
 
     @property

@@ -101,6 +101,10 @@ class ManualController:
     def reset(self, seed: int | None = None) -> None:
         self.values = np.array([0.0, 0.0, 0.0, self.start_throttle])
         self.held.clear()
+        if self.cockpit is not None:  # FlightGear's stick stays where the person holds it
+            self.cockpit.poll()
+            if self.cockpit.latest is not None:
+                self.values[:] = self.cockpit.latest
 
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
         if self.cockpit is not None:

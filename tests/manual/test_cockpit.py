@@ -57,6 +57,8 @@ def test_flightgear_device_acts_on_the_newest_packet():
         assert pilot.act(obs) == pytest.approx([0.5, -0.3, -0.2, 0.9])
         assert pilot.act(obs) == pytest.approx([0.5, -0.3, -0.2, 0.9])  # held until the next
         assert "cockpit" in pilot.status
+        pilot.reset(0)  # a new episode starts from where FlightGear's stick is
+        assert pilot.act(obs) == pytest.approx([0.5, -0.3, -0.2, 0.9])
     finally:
         pilot.close()
 
