@@ -90,8 +90,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     _running(auto)
     manual = sub.add_parser(
         "manual",
-        help="a person flies (keyboard, mouse or joystick) in a pygame window; every completed "
-        "episode is saved at once",
+        help="a person flies (keyboard, mouse, joystick or FlightGear's cockpit) in a pygame "
+        "window; every completed episode is saved at once",
         description="A person flies in real time; Space starts an episode, E saves it, "
         "Backspace discards it, T takes over from --assist, Q quits.",
     )
