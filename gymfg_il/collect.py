@@ -99,8 +99,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     _running(auto)
     manual = sub.add_parser(
         "manual",
-        help="a person flies (keyboard, mouse or joystick) in a pygame window; every completed "
-        "episode is saved at once",
+        help="a person flies (keyboard, mouse, joystick or FlightGear's cockpit) in a pygame "
+        "window; every completed episode is saved at once",
         description="A person flies in real time; Space starts an episode, E saves it, "
         "Backspace discards it, T takes over from --assist, Q quits.",
     )
@@ -243,7 +243,12 @@ def _fly_by_hand(cfg: object, show_progress: bool = True) -> int:
         cfg.flight(),
         cfg.out,
         cfg.device,
-        {"keyboard": cfg.keyboard, "mouse": cfg.mouse, "joystick": cfg.joystick},
+        {
+            "keyboard": cfg.keyboard,
+            "mouse": cfg.mouse,
+            "joystick": cfg.joystick,
+            "flightgear": cfg.flightgear,
+        },
         cfg.assist,
         cfg.seed,
         cfg.episodes,

@@ -53,7 +53,9 @@ class CollectConfig:
         pilot_view: manual only: the camera the window shows beside the instruments
             (``front``, ``chase``, or ``none``), so a person can fly without FlightGear.
         task_kwargs: arguments of the task class (e.g. ``target_range``).
-        device: manual only: keyboard, mouse or joystick.
+        device: manual only: keyboard, mouse, joystick or flightgear (fly from FlightGear's
+            own cockpit: fgfs --fdm=null --native-fdm=socket,in,30,,VIEW,udp
+            --native-ctrls=socket,out,30,127.0.0.1,5700,udp, with --view VIEW here).
         assist: manual only: ``controller`` or a policy folder that flies until the person
             takes over (T); the person's frames are flagged as interventions.
         view: manual only: UDP ports of FlightGear out-the-window views (repeatable; see
@@ -65,6 +67,8 @@ class CollectConfig:
         keyboard: manual only: key bindings (see ``manual.bindings.KeyboardBindings``).
         mouse: manual only: mouse bindings (``MouseBindings``).
         joystick: manual only: joystick axes, dead zones, expo, buttons (``JoystickBindings``).
+        flightgear: manual only: where FlightGear's controls arrive (``FlightGearBindings``:
+            port, host).
     """
 
     kind: Literal["autopilot", "manual"] = "autopilot"
@@ -83,7 +87,7 @@ class CollectConfig:
     image_size: int = 128
     pilot_view: Literal["front", "chase", "none"] = "front"
     task_kwargs: dict[str, Any] = field(default_factory=dict)
-    device: Literal["keyboard", "mouse", "joystick"] = "keyboard"
+    device: Literal["keyboard", "mouse", "joystick", "flightgear"] = "keyboard"
     assist: str | None = None
     view: list[int] = field(default_factory=list, metadata={"repeat": True})
     pilot: Literal["person", "synthetic"] = "person"
@@ -91,6 +95,7 @@ class CollectConfig:
     keyboard: dict[str, Any] = field(default_factory=dict)
     mouse: dict[str, Any] = field(default_factory=dict)
     joystick: dict[str, Any] = field(default_factory=dict)
+    flightgear: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         typed = type_problems(self)
@@ -100,8 +105,10 @@ class CollectConfig:
         problems = []
         if self.kind not in ("autopilot", "manual"):
             problems.append(f"kind={self.kind!r}: choose autopilot or manual")
-        if self.device not in ("keyboard", "mouse", "joystick"):
-            problems.append(f"device={self.device!r}: choose keyboard, mouse or joystick")
+        if self.device not in ("keyboard", "mouse", "joystick", "flightgear"):
+            problems.append(
+                f"device={self.device!r}: choose keyboard, mouse, joystick or flightgear"
+            )
         if self.task in ("dummy",):
             problems.append("task 'dummy' has no controller to demonstrate it")
         elif self.episode_time_s is not None and not (

@@ -25,6 +25,7 @@ from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.manual.bindings import (
+    FlightGearBindings,
     JoystickBindings,
     KeyboardBindings,
     MouseBindings,
@@ -91,6 +92,8 @@ def help_lines(device: str, kb: KeyboardBindings) -> list[str]:
         lines.append("STICK    the mouse pointer (offset from the window centre)")
     elif device == "joystick":
         lines.append("STICK    joystick axes (see the recipe's [collector.joystick])")
+    elif device == "flightgear":
+        return [*lines, "CONTROLS FlightGear's cockpit (its --native-ctrls stream)"]
     else:
         lines += [
             f"AILERON  {keys(kb.aileron_left)}  |  {keys(kb.aileron_right)}",
@@ -119,8 +122,9 @@ class ManualSession:
     Args:
         flight: what to fly (a solo flight spec).
         out: session folder (``logs/``, ``dataset/``).
-        device: keyboard, mouse or joystick.
-        bindings: recipe tables ``{"keyboard": {...}, "mouse": {...}, "joystick": {...}}``.
+        device: keyboard, mouse, joystick or flightgear (FlightGear's cockpit).
+        bindings: recipe tables ``{"keyboard": {...}, "mouse": {...}, "joystick": {...},
+            "flightgear": {...}}``.
         assist: None, ``"controller"`` or a policy checkpoint path: it flies unless the human
             takes over (T); the human's frames are flagged as interventions.
         seed: seed of the first episode (a discarded episode is flown again with its seed).
@@ -173,6 +177,9 @@ class ManualSession:
             from_table(MouseBindings, bindings.get("mouse"), "[collector.mouse]"),
             from_table(JoystickBindings, bindings.get("joystick"), "[collector.joystick]"),
             throttle=self.env.aircraft.profile.cruise_throttle,
+            flightgear=from_table(
+                FlightGearBindings, bindings.get("flightgear"), "[collector.flightgear]"
+            ),
         )
         self.assist_name = (
             None if assist is None else ("controller" if assist == "controller" else "policy")
@@ -375,6 +382,7 @@ class ManualSession:
             self.writer.close()
             self.writer = None
         self.env.close()
+        self.human.close()
         self.gui.close()
         if not self.build_each and self.stats.saved:
             self.updater.request()

@@ -8,10 +8,11 @@ from dataclasses import dataclass, field
 
 from gymfg_il.envs.scenarios import Scenario
 from gymfg_il.errors import ConfigError
-from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
+from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, ORIENTATION, POSITION, indices
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
 from gymfg_il.sim.weather import Weather
 from gymfg_il.viz.multiplayer import port_problem
+from gymfg_il.viz.peers import MultiplayerConfig
 
 
 @dataclass(frozen=True)
@@ -31,6 +32,10 @@ class EnvConfig:
             (``FlightGear(multiplayer_port=...)``): every other aircraft of the simulation,
             opponents of an online client included, is sent there and appears in the view.
         weather: turbulence and wind (``sim.weather.Weather``), seeded per episode.
+        multiplayer: FlightGear multiplayer (``viz.peers.MultiplayerConfig``): every
+            FlightGear aircraft heard on its port is an opponent (position and orientation
+            only), our aircraft are sent to its ``send_to`` addresses, and the simulation
+            paces itself to real time, FlightGear's clock.
     """
 
     sim_hz: int = DEFAULT_SIM_HZ
@@ -40,6 +45,7 @@ class EnvConfig:
     views: Mapping[str, Sequence[int]] | None = None
     traffic: Mapping[str, Sequence[int]] | None = None
     weather: Weather = field(default_factory=Weather)
+    multiplayer: MultiplayerConfig | None = None
 
     def __post_init__(self) -> None:
         substeps(self.sim_hz, self.agent_hz)
@@ -56,6 +62,17 @@ class EnvConfig:
         indices(view)
         if len(set(view)) != len(view):
             raise ConfigError(f"opponent_view lists a variable twice: {view}")
+        if self.multiplayer is not None:
+            if not isinstance(self.multiplayer, MultiplayerConfig):
+                raise ConfigError(
+                    f"multiplayer must be a MultiplayerConfig, got {self.multiplayer!r}"
+                )
+            unseen = [v for v in view if v not in POSITION + ORIENTATION]
+            if unseen:
+                raise ConfigError(
+                    f"opponent_view {list(unseen)}: FlightGear aircraft show only "
+                    f"{list(POSITION + ORIENTATION)}; drop the others or the multiplayer"
+                )
         if self.scenario is not None and not callable(self.scenario):
             raise ConfigError(
                 f"scenario must be callable (rng, aircraft) -> ics, got {self.scenario!r}"

@@ -29,6 +29,7 @@ from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 from gymfg_il.sim.weather import Weather
+from gymfg_il.viz.peers import MultiplayerConfig
 
 TeamState = list[np.ndarray]
 
@@ -43,6 +44,11 @@ class OfflineEnv:
         sim_hz, agent_hz, opponent_view, scenario, views, traffic, weather: see ``EnvConfig``
             (views: callsign -> FlightGear UDP ports; traffic: callsign -> the multiplayer
             ports of its views, where the other aircraft are shown).
+        multiplayer: FlightGear multiplayer (``MultiplayerConfig``): people flying FlightGear
+            join as opponents, heard on ``listen_port``; every aircraft here is sent to its
+            ``send_to`` addresses. While it is set, ``step`` keeps to the wall clock (one
+            step per ``1 / agent_hz`` seconds), because a person's aircraft flies in real
+            time.
 
     ``reset(team)`` returns ``(team_state, opponent_states)``: one observation (float32) per
     aircraft of ``team`` in roster order, and an ``(n, len(opponent_view))`` array of what the
@@ -55,6 +61,11 @@ class OfflineEnv:
     its reward is 0 and its action is ignored from then on; from the next step it is absent
     from the others' ``opponent_states`` (``info["opponent_callsigns"]`` names the rows) and
     from their rewards' ``ctx.targets``, as an online server drops a team that left.
+
+    FlightGear aircraft (``multiplayer``) come after this simulation's aircraft in
+    ``opponent_states`` (by callsign, position and orientation only); one silent for
+    ``timeout_s`` leaves the rows and ``ctx.targets`` the same way. A reward target naming a
+    callsign that is not simulated here (``c172p("person")``) is looked for among them.
     """
 
     def __init__(
@@ -68,9 +79,17 @@ class OfflineEnv:
         views: Mapping[str, Sequence[int]] | None = None,
         traffic: Mapping[str, Sequence[int]] | None = None,
         weather: Weather | None = None,
+        multiplayer: MultiplayerConfig | None = None,
     ) -> None:
         self.config = EnvConfig(
-            sim_hz, agent_hz, tuple(opponent_view), scenario, views, traffic, weather or Weather()
+            sim_hz,
+            agent_hz,
+            tuple(opponent_view),
+            scenario,
+            views,
+            traffic,
+            weather or Weather(),
+            multiplayer,
         )
         self.opponents: list[tuple[Team, list[Agent]]] = []
         for entry in opponents:
@@ -169,7 +188,7 @@ class OfflineEnv:
             "time_s": world.steps * world.dt,
             "terminated": [s.terminated for s in slots],
             "reasons": {s.callsign: s.reason for s in world.slots if s.reason},
-            "opponent_callsigns": [s.callsign for s in world.opponents_of(team.name, True)],
+            "opponent_callsigns": world.opponent_callsigns(team.name, True),
         }
         return (
             self._team_state(),

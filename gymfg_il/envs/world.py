@@ -7,7 +7,9 @@ clock; it knows nothing about who chooses the actions.
 
 from __future__ import annotations
 
+import logging
 import math
+import time
 import zlib
 from collections import deque
 from collections.abc import Mapping, Sequence
@@ -23,11 +25,14 @@ from gymfg_il.envs.display import Displays
 from gymfg_il.envs.team import Team, build_task, check_unique
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
-from gymfg_il.sim.properties import NAMES, StateView, indices
+from gymfg_il.sim.properties import NAMES, ORIENTATION, POSITION, StateView, indices
 from gymfg_il.sim.simulation import Simulation
 from gymfg_il.sim.timing import episode_steps
 from gymfg_il.tasks.base import Task
 from gymfg_il.tasks.rewards import RewardContext
+from gymfg_il.viz.peers import MultiplayerLink, Peer
+
+log = logging.getLogger(__name__)
 
 __all__ = ["EnvConfig", "SimPool", "Slot", "World"]
 
@@ -147,9 +152,22 @@ class World:
         self.by_callsign = {s.callsign: s for s in self.slots}
         self.team_slots = {t.name: [s for s in self.slots if s.team == t.name] for t in teams}
         self.external: dict[str, StateView] = {}
-        self.external_targets = external_targets
+        # FlightGear aircraft may be reward targets: seen like an online server's teams
+        self.external_targets = external_targets or config.multiplayer is not None
         self._link_reward_targets()
         self.displays = Displays(self.by_callsign, config.views, config.traffic, self.dt)
+        self.link: MultiplayerLink | None = None
+        self.peers: dict[str, Peer] = {}  # FlightGear aircraft heard, by callsign
+        self._pose_idx = indices(POSITION + ORIENTATION)
+        self._peer_cols = [(POSITION + ORIENTATION).index(v) for v in config.opponent_view]
+        self._next_frame = 0.0
+        if config.multiplayer is not None:
+            self.link = MultiplayerLink(config.multiplayer)
+            log.info(
+                "FlightGear multiplayer: the simulation runs in real time (%g steps/s), "
+                "FlightGear's clock",
+                config.agent_hz,
+            )
         self.steps = 0
         self.started = False
 
@@ -237,6 +255,8 @@ class World:
         self.started = True
         if self.displays:
             self.displays.show()
+        if self.link is not None:
+            self._exchange()
 
     def advance(self, actions: Sequence[Controls | None]) -> None:
         """Apply one action per slot (None for terminated aircraft), step, score, check ends."""
@@ -260,6 +280,28 @@ class World:
         self.steps += 1
         if self.displays:
             self.displays.show()
+        if self.link is not None:
+            self._exchange()
+
+    def _exchange(self) -> None:
+        """Send our aircraft to FlightGear, hear FlightGear's, and keep to its clock (real
+        time; the views pace instead when there are any)."""
+        link = self.link
+        assert link is not None
+        for slot in self.slots:
+            pose = slot.state[self._pose_idx]
+            if slot.present(self.steps) and np.isfinite(pose).all():
+                link.send(slot.callsign, slot.aircraft.model, pose)
+        # a server may echo our own aircraft back: they are not FlightGear's
+        self.peers = {c: p for c, p in link.poll().items() if c not in self.by_callsign}
+        for callsign, view in self.external.items():
+            peer = self.peers.get(callsign)
+            view.values[:] = np.nan if peer is None else np.take(peer.pose, self._peer_cols)
+        if not self.displays:
+            now = time.perf_counter()
+            if self._next_frame > now:
+                time.sleep(self._next_frame - now)
+            self._next_frame = max(now, self._next_frame) + self.dt
 
     def score(self) -> None:
         """Rewards and terminations of the step just taken."""
@@ -323,15 +365,25 @@ class World:
             s for s in self.slots if s.team != team and (not present_only or s.present(self.steps))
         ]
 
+    def opponent_callsigns(self, team: str, present_only: bool = False) -> list[str]:
+        """Who the rows of ``opponent_states`` are: ``opponents_of``, then the FlightGear
+        aircraft heard (by callsign)."""
+        own = [s.callsign for s in self.opponents_of(team, present_only)]
+        return own + sorted(self.peers)
+
     def opponent_states(self, team: str, present_only: bool = False) -> np.ndarray:
         """What ``team`` sees of other teams' aircraft: (n, len(opponent_view)) float64, in
-        the order of ``opponents_of``."""
+        the order of ``opponent_callsigns``: this simulation's, then FlightGear's."""
         rows = [s.state[self.view_idx] for s in self.opponents_of(team, present_only)]
+        rows += [np.take(self.peers[c].pose, self._peer_cols) for c in sorted(self.peers)]
         if not rows:
             return np.zeros((0, len(self.view_idx)))
         return np.stack(rows)
 
     def close(self) -> None:
         self.displays.close()
+        if self.link is not None:
+            self.link.close()
+            self.link = None
         self.pool.give_back([s.sim for s in self.slots])
         self.slots = []

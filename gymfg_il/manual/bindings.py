@@ -116,6 +116,24 @@ class JoystickBindings:
         return x
 
 
+@dataclass
+class FlightGearBindings:
+    """FlightGear as the cockpit: FlightGear's ``--native-ctrls=socket,out,HZ,HOST,PORT,udp``
+    stream gives the controls (FlightGear's own joystick and keyboard bindings apply).
+
+    Attributes:
+        port: UDP port FlightGear sends its controls to (the PORT of --native-ctrls).
+        host: address to listen on; loopback by default.
+    """
+
+    port: int = 5700
+    host: str = "127.0.0.1"
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.port, int) and 0 < self.port < 65536):
+            raise ConfigError(f"flightgear bindings: port={self.port!r}: want 1..65535")
+
+
 def _check_positive(obj: object, names: tuple[str, ...], allow_zero: tuple[str, ...] = ()) -> None:
     bad = [f"{n}={getattr(obj, n)!r}" for n in names if not getattr(obj, n) > 0]
     bad += [f"{n}={getattr(obj, n)!r}" for n in allow_zero if not getattr(obj, n) >= 0]

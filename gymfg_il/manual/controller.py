@@ -1,22 +1,32 @@
-"""The ManualController: a person's keyboard, mouse or joystick as an Agent.
+"""The ManualController: a person's keyboard, mouse, joystick or FlightGear cockpit as an Agent.
 
 The session loop hands it each frame's pygame events (``handle``); ``act`` returns the
 controls as they stand. Keyboard and joystick state is built from events (KEYDOWN/KEYUP,
 JOYAXISMOTION, ...), never from polling, so injected events drive it exactly like real ones.
+The ``flightgear`` device reads FlightGear's controls stream instead (``manual.cockpit``),
+at every ``handle`` and ``act``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.manual.bindings import JoystickBindings, KeyboardBindings, MouseBindings
+from gymfg_il.manual.bindings import (
+    FlightGearBindings,
+    JoystickBindings,
+    KeyboardBindings,
+    MouseBindings,
+)
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
 
-DEVICES = ("keyboard", "mouse", "joystick")
+if TYPE_CHECKING:
+    from gymfg_il.manual.cockpit import CockpitReceiver
+
+DEVICES = ("keyboard", "mouse", "joystick", "flightgear")
 
 
 def _pg() -> Any:
@@ -30,8 +40,10 @@ class ManualController:
 
     Args:
         device: ``keyboard``, ``mouse`` (stick from the pointer, throttle and rudder on the
-            keyboard) or ``joystick``.
+            keyboard), ``joystick`` or ``flightgear`` (FlightGear's own cockpit, its controls
+            read from ``--native-ctrls``; the keyboard only runs the session).
         keyboard, mouse, joystick: the bindings (defaults: FlightGear-like).
+        flightgear: where FlightGear's controls arrive (``FlightGearBindings``).
         throttle: throttle at the start of each episode.
         window_size: the window the mouse stick is centred in.
     """
@@ -44,6 +56,7 @@ class ManualController:
         joystick: JoystickBindings | None = None,
         throttle: float = 0.7,
         window_size: tuple[int, int] = (900, 600),
+        flightgear: FlightGearBindings | None = None,
     ) -> None:
         if device not in DEVICES:
             raise ConfigError(f"device={device!r}: choose one of {', '.join(DEVICES)}")
@@ -58,6 +71,13 @@ class ManualController:
         self.joysticks: dict[int, Any] = {}  # instance id -> pygame Joystick (or None)
         self.status = ""
         self._key_of = self._index_keys()
+        self.cockpit: CockpitReceiver | None = None
+        if device == "flightgear":
+            from gymfg_il.manual.cockpit import CockpitReceiver
+
+            fg = flightgear or FlightGearBindings()
+            self.cockpit = CockpitReceiver(fg.port, fg.host)
+            self.status = f"flightgear: waiting for controls on {fg.host}:{fg.port}"
 
     def _index_keys(self) -> dict[str, tuple[int, float]]:
         """key name -> (control index, direction)."""
@@ -82,12 +102,31 @@ class ManualController:
         self.values = np.array([0.0, 0.0, 0.0, self.start_throttle])
 
     def start_from(self, action: np.ndarray) -> None:
-        """Hold the aircraft's start controls (its trimmed throttle) until the pilot moves."""
+        """Hold the aircraft's start controls (a trimmed start's trim) until the pilot moves."""
         self.values = np.array(action, dtype=np.float64)
         self.held.clear()
+        if self.cockpit is not None:  # FlightGear's stick stays where the person holds it
+            self.cockpit.poll()
+            if self.cockpit.latest is not None:
+                self.values[:] = self.cockpit.latest
 
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        if self.cockpit is not None:
+            self._cockpit()
         return self.values.copy()
+
+    def _cockpit(self) -> None:
+        assert self.cockpit is not None
+        values = self.cockpit.poll()
+        if values is not None:
+            self.values[:] = values
+            self.status = "flightgear: flying from FlightGear's cockpit"
+        elif self.cockpit.received and self.cockpit.silent_s > 1.0:
+            self.status = "flightgear: no controls for over a second; is fgfs still running?"
+
+    def close(self) -> None:
+        if self.cockpit is not None:
+            self.cockpit.close()
 
     def set_throttle(self, throttle: float) -> None:
         self.values[3] = throttle
@@ -108,7 +147,10 @@ class ManualController:
                 self._mouse(ev.pos)
             elif self.device == "joystick":
                 commands += self._joystick_event(pg, ev)
-        self._keyboard(dt, surfaces=self.device == "keyboard")
+        if self.cockpit is not None:
+            self._cockpit()
+        else:
+            self._keyboard(dt, surfaces=self.device == "keyboard")
         return commands
 
     def _keyboard(self, dt: float, surfaces: bool) -> None:

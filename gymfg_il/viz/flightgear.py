@@ -35,6 +35,19 @@ FUEL_TANKS = tuple(
 )
 
 
+# Rendering light enough that fgfs under Xvfb takes under one core and streams at ~26 Hz
+# (full rendering takes both cores here at ~6 fps, and every stream falls to ~5 Hz); use
+# with geometry="320x240"
+LIGHTWEIGHT = (
+    "--disable-clouds",
+    "--disable-clouds3d",
+    "--disable-random-objects",
+    "--disable-random-vegetation",
+    "--disable-random-buildings",
+    "--prop:/sim/frame-rate-throttle-hz=30",
+)
+
+
 class FlightGearError(GymFGError, RuntimeError):
     """FlightGear is missing, failed to start, or stopped answering."""
 
@@ -47,7 +60,9 @@ class FlightGear:
     """A running ``fgfs`` bound to one native-fdm UDP port.
 
     Args:
-        port: UDP port the view listens on (the env's ``views`` send there).
+        port: UDP port the view listens on (the env's ``views`` send there); None:
+            FlightGear flies the aircraft itself, with its own FDM (a person's aircraft,
+            seen by the env through ``multiplayer_out``).
         telnet_port: FlightGear's property server (``get /position/altitude-ft``).
         aircraft: FlightGear aircraft to draw (``c172p`` ships with the Debian package).
         rate_hz: packets per second FlightGear expects.
@@ -57,12 +72,15 @@ class FlightGear:
             it; GymFG's default start is near KSFO, whose scenery ships with FlightGear.
         multiplayer_port: UDP port for other aircraft (``EnvConfig.traffic``); at most
             32767, which is all FlightGear 2020.3 can store.
+        multiplayer_out: where FlightGear sends its own aircraft (a ``MultiplayerConfig``'s
+            ``listen_port`` on this machine); the discard port by default.
+        callsign: FlightGear's callsign in multiplayer (7 characters are kept).
         extra: more fgfs options.
     """
 
     def __init__(
         self,
-        port: int,
+        port: int | None,
         telnet_port: int,
         aircraft: str = "c172p",
         rate_hz: int = 30,
@@ -71,12 +89,19 @@ class FlightGear:
         airport: str = "KSFO",
         multiplayer_port: int | None = None,
         extra: tuple[str, ...] = (),
+        multiplayer_out: int | None = None,
+        callsign: str = "gymfg-view",
     ) -> None:
         from gymfg_il.viz.multiplayer import port_problem
 
-        problem = None if multiplayer_port is None else port_problem(multiplayer_port)
-        if problem:
-            raise FlightGearError(problem)
+        problems = [port_problem(p) for p in (multiplayer_port, multiplayer_out) if p is not None]
+        if any(problems):
+            raise FlightGearError("; ".join(p for p in problems if p))
+        if multiplayer_out is not None and multiplayer_port is None:
+            raise FlightGearError(
+                "multiplayer_out needs a multiplayer_port too: without --multiplay=in fgfs "
+                "binds its out port itself"
+            )
         exe = find_fgfs()
         if exe is None:
             raise FlightGearError(
@@ -90,19 +115,23 @@ class FlightGear:
         traffic = (
             (
                 f"--multiplay=in,{rate_hz},127.0.0.1,{multiplayer_port}",
-                f"--multiplay=out,{rate_hz},127.0.0.1,9",
-                "--callsign=gymfg-view",
+                f"--multiplay=out,{rate_hz},127.0.0.1,{multiplayer_out or 9}",
+                f"--callsign={callsign}",
             )
             if multiplayer_port
             else ()
         )
         self.home = tempfile.mkdtemp(prefix="gymfg-fghome-")
+        follow = (
+            ("--fdm=null", f"--native-fdm=socket,in,{rate_hz},,{port},udp")
+            if port is not None
+            else ()
+        )
         cmd = [
             exe,
-            "--fdm=null",
-            f"--native-fdm=socket,in,{rate_hz},,{port},udp",
+            *follow,
             f"--aircraft={aircraft}",
-            f"--telnet=socket,bi,10,localhost,{telnet_port},tcp",
+            f"--telnet=socket,bi,30,localhost,{telnet_port},tcp",  # served each frame
             "--disable-sound",
             "--disable-terrasync",
             "--launcher=0",
@@ -112,7 +141,7 @@ class FlightGear:
             "--disable-ai-traffic",
             f"--airport={airport}",
             "--prop:/sim/rendering/multi-sample-buffers=0",
-            *FUEL_TANKS,
+            *(FUEL_TANKS if port is not None else ()),
             *traffic,
             *extra,
         ]
@@ -171,6 +200,15 @@ class FlightGear:
 
     def get_float(self, prop: str) -> float:
         return float(self.get(prop))
+
+    def set(self, prop: str, value: object) -> None:
+        """Set a property, as a person's stick or switch would (no reply comes back)."""
+        sock = self._connect()
+        try:
+            sock.sendall(f"set {prop} {value}\r\n".encode())
+        except OSError:
+            self._sock = None
+            raise
 
     def stop(self) -> None:
         if self._sock is not None:

@@ -1,13 +1,19 @@
 """The multiplayer position message, checked without FlightGear (the FlightGear test reads the
 same traffic back from a real one)."""
 
+import json
 import math
+import os
 import socket
 import struct
+import subprocess
+import sys
+import time
 
 import pytest
 
 from gymfg_il.viz import multiplayer as mp
+from gymfg_il.viz import peers
 
 
 def euler_from(angle_axis, lat_deg, lon_deg):
@@ -69,3 +75,121 @@ def test_message_layout_and_delivery():
 def test_ports_flightgear_cannot_store_are_refused():
     with pytest.raises(ValueError, match="32767"):
         mp.TrafficSender([40000])
+
+
+# -- receiving ------------------------------------------------------------------------------
+
+
+def free_mp_port():
+    """A free UDP port FlightGear could store (it keeps ports in 16 bits)."""
+    for port in range(22000 + os.getpid() % 9000, 32000):
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+            try:
+                s.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+            return port
+    raise RuntimeError("no free UDP port below 32000")
+
+
+@pytest.mark.parametrize(
+    "pose",
+    [
+        (37.6, -122.4, 5000.0, 10.0, 5.0, 45.0),
+        (-33.9, 151.2, 120.0, -60.0, -20.0, 300.0),
+        (64.0, -21.0, 38000.0, 170.0, 80.0, 180.0),
+    ],
+)
+def test_decode_inverts_what_we_send(pose):
+    packet = mp.pack("person-1", "c172p", 12.5, *pose)
+    # FlightGear's own messages carry a property section after the position: ignored
+    peer = peers.decode(packet + b"\0" * 661, heard_at=3.0)
+    assert (peer.callsign, peer.model, peer.time_s) == (
+        "person-",
+        "Aircraft/c172p/Models/c172p.xml",
+        12.5,
+    )
+    got = peer.pose
+    assert got[:2] == pytest.approx(pose[:2], abs=1e-9)  # ~0.1 mm
+    assert got[2] == pytest.approx(pose[2], abs=1e-3)
+    assert got[3:5] == pytest.approx(pose[3:5], abs=1e-4)  # float32 angle-axis
+    assert abs((got[5] - pose[5] + 180) % 360 - 180) < 1e-4
+
+
+@pytest.mark.parametrize(
+    "mangle, match",
+    [
+        (lambda b: b[:100], "shorter"),
+        (lambda b: b"XXXX" + b[4:], "magic"),
+        (lambda b: b[:8] + struct.pack(">I", 1) + b[12:], "message id 1"),
+    ],
+)
+def test_decode_refuses_what_is_not_a_position_message(mangle, match):
+    packet = mp.pack("x", "c172p", 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    with pytest.raises(peers.MessageError, match=match):
+        peers.decode(mangle(packet))
+
+
+def test_link_keeps_the_latest_per_callsign_and_drops_the_silent():
+    now = [100.0]
+    port = free_mp_port()
+    link = peers.MultiplayerLink(
+        peers.MultiplayerConfig(listen_port=port, timeout_s=2.0), clock=lambda: now[0]
+    )
+    sender = mp.TrafficSender([port])
+    try:
+        sender.send("alice", "c172p", (37.6, -122.4, 3000.0, 0.0, 0.0, 90.0))
+        sender.send("bob", "f15", (37.7, -122.4, 9000.0, 0.0, 0.0, 10.0))
+        sender.send("alice", "c172p", (37.6, -122.4, 3100.0, 0.0, 0.0, 90.0))
+        sender.sock.sendto(b"not a message", ("127.0.0.1", port))
+        time.sleep(0.05)
+        heard = link.poll()
+        assert sorted(heard) == ["alice", "bob"]
+        assert heard["alice"].altitude_ft == pytest.approx(3100.0, abs=1e-3)
+        assert link.rejected == 1
+        now[0] += 1.5
+        sender.send("bob", "f15", (37.7, -122.4, 9000.0, 0.0, 0.0, 10.0))
+        time.sleep(0.05)
+        assert sorted(link.poll()) == ["alice", "bob"]
+        now[0] += 1.0  # alice silent 2.5 s, bob 1.0 s
+        assert sorted(link.poll()) == ["bob"]
+    finally:
+        sender.close()
+        link.close()
+
+
+def test_config_names_bad_ports_and_timeouts():
+    with pytest.raises(ValueError, match=r"listen_port.*32767"):
+        peers.MultiplayerConfig(listen_port=40000)
+    with pytest.raises(ValueError, match=r"send_to 127.0.0.1.*32767.*timeout_s=0"):
+        peers.MultiplayerConfig(send_to=[("127.0.0.1", 99999)], timeout_s=0)
+
+
+def test_listen_prints_what_it_hears(tmp_path):
+    port = free_mp_port()
+    out = tmp_path / "heard.jsonl"
+    cmd = [sys.executable, "-m", "gymfg_il.viz.multiplayer", "listen", "--port", str(port)]
+    proc = subprocess.Popen(
+        [*cmd, "--seconds", "1.6", "--json", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    sender = mp.TrafficSender([port])
+    deadline = time.monotonic() + 20
+    while proc.poll() is None and time.monotonic() < deadline:
+        sender.send("person", "c172p", (37.6, -122.4, 3000.0, 15.0, 2.0, 270.0))
+        time.sleep(0.05)
+    sender.close()
+    stdout, stderr = proc.communicate(timeout=20)
+    assert proc.returncode == 0, stderr
+    lines = [json.loads(line) for line in out.read_text().splitlines()]
+    assert lines and lines == [json.loads(line) for line in stdout.splitlines()]
+    first = lines[0]
+    assert first["callsign"] == "person" and first["model"].endswith("c172p.xml")
+    assert first["altitude_ft"] == pytest.approx(3000.0, abs=0.01)
+    assert (first["roll_deg"], first["heading_deg"]) == pytest.approx((15.0, 270.0), abs=1e-3)
+    assert set(first) == {
+        "callsign", "model", "latitude_deg", "longitude_deg", "altitude_ft",
+        "roll_deg", "pitch_deg", "heading_deg",
+    }  # fmt: skip

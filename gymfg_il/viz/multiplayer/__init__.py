@@ -61,11 +61,16 @@ _A = 6378137.0  # WGS84
 _E2 = (1 / 298.257223563) * (2 - 1 / 298.257223563)
 _FT = 0.3048
 _D2R = math.pi / 180.0
+# FlightGear turns degrees into radians for its multiplayer position with a float32 constant
+# (SimGear's SG_DEGREES_TO_RADIANS), 7.7e-9 short of pi/180: a 9 cm shift at San Francisco.
+# Positions use its constant both ways, so what FlightGear sends decodes to what it shows.
+FG_D2R: float = struct.unpack("f", struct.pack("f", _D2R))[0]
 
 
 def ecef(lat_deg: float, lon_deg: float, altitude_ft: float) -> tuple[float, float, float]:
-    """Earth-centred, earth-fixed position (m) of a WGS84 geodetic position."""
-    lat, lon, h = lat_deg * _D2R, lon_deg * _D2R, altitude_ft * _FT
+    """Earth-centred, earth-fixed position (m) of a WGS84 geodetic position, as FlightGear
+    computes it (``FG_D2R``)."""
+    lat, lon, h = lat_deg * FG_D2R, lon_deg * FG_D2R, altitude_ft * _FT
     s = math.sin(lat)
     n = _A / math.sqrt(1.0 - _E2 * s * s)
     c = (n + h) * math.cos(lat)

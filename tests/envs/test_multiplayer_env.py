@@ -1,0 +1,105 @@
+"""FlightGear aircraft heard over multiplayer are opponents of the offline env, without a
+FlightGear: a sender on this machine plays FlightGear's part (``tests/viz/test_flightgear_mp.py``
+does the same against a real one)."""
+
+import os
+import socket
+import time
+
+import numpy as np
+import pytest
+
+from gymfg_il import Team
+from gymfg_il.aircraft import c172p
+from gymfg_il.envs import OfflineEnv
+from gymfg_il.errors import ConfigError
+from gymfg_il.tasks import DummyTask
+from gymfg_il.viz import multiplayer as mp
+from gymfg_il.viz import peers
+from gymfg_il.viz.peers import MultiplayerConfig
+
+pytestmark = pytest.mark.network
+
+
+def free_udp_ports(n):
+    """``n`` free UDP ports FlightGear could store (below 32768)."""
+    found = []
+    for port in range(23000 + os.getpid() % 8000, 32000):
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+            try:
+                s.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+        found.append(port)
+        if len(found) == n:
+            return found
+    raise RuntimeError("no free UDP ports below 32000")
+
+
+PERSON = (37.62, -122.37, 3000.0, 20.0, 3.0, 280.0)
+
+
+def test_a_flightgear_aircraft_is_an_opponent_and_a_reward_target_until_it_falls_silent():
+    listen, fg_in = free_udp_ports(2)
+    seen = []
+
+    def note_person(ctx):  # what the reward sees of the person: their pose, or None
+        view = ctx.targets.get("person")
+        seen.append(None if view is None else view.values.copy())
+        return 0.0
+
+    team = Team(
+        "blue",
+        [(c172p("ego"), DummyTask(reward=note_person))],
+        reward_function_targets={c172p("ego"): [c172p("person")]},
+    )
+    config = MultiplayerConfig(listen_port=listen, send_to=[("127.0.0.1", fg_in)], timeout_s=0.5)
+    fg = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)  # FlightGear's --multiplay=in
+    fg.bind(("127.0.0.1", fg_in))
+    fg.settimeout(5)
+    person = mp.TrafficSender([listen])
+    env = OfflineEnv(agent_hz=30, multiplayer=config)
+    try:
+        env.configure(team)  # the env listens from here on
+        person.send("person", "c172p", PERSON)
+        time.sleep(0.05)
+        _, rows = env.reset(team, seed=0)
+        assert rows.shape == (1, 6)
+        assert rows[0] == pytest.approx(PERSON, abs=1e-4)
+        # our aircraft reaches FlightGear as multiplayer traffic
+        heard = peers.decode(fg.recv(4096))
+        assert heard.callsign == "ego" and heard.model.endswith("c172p.xml")
+        action = np.array([0.0, 0.0, 0.0, 0.7])
+        t0 = time.perf_counter()
+        for _ in range(9):
+            person.send("person", "c172p", PERSON)
+            _, rows, rewards, _, _, info = env.step(action)
+            assert info["opponent_callsigns"] == ["person"]
+        took = time.perf_counter() - t0
+        assert 0.25 < took < 0.6  # 9 steps at 30 Hz: real time
+        assert seen[-1] is not None and seen[-1] == pytest.approx(PERSON, abs=1e-4)
+        for _ in range(30):  # 1 s of silence: dropped after 0.5 s
+            _, rows, rewards, *_, info = env.step(action)
+        assert rows.shape == (0, 6) and info["opponent_callsigns"] == []
+        assert seen[-1] is None and np.isfinite(rewards).all()
+    finally:
+        env.close()
+        person.close()
+        fg.close()
+
+
+def test_flightgear_opponents_show_only_position_and_orientation():
+    with pytest.raises(ConfigError, match="FlightGear aircraft show only"):
+        OfflineEnv(
+            multiplayer=MultiplayerConfig(listen_port=free_udp_ports(1)[0]),
+            opponent_view=("lat_deg", "lon_deg", "airspeed_kts"),
+        )
+
+
+def test_a_taken_port_is_a_config_error_naming_it():
+    port = free_udp_ports(1)[0]
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as taken:
+        taken.bind(("127.0.0.1", port))
+        env = OfflineEnv(multiplayer=MultiplayerConfig(listen_port=port))
+        with pytest.raises(ConfigError, match=f"127.0.0.1:{port}"):
+            env.configure(Team("blue", [(c172p("ego"), DummyTask)]))
