@@ -99,11 +99,14 @@ class ManualController:
 
     # -- Agent ---------------------------------------------------------------------------
     def reset(self, seed: int | None = None) -> None:
-        self.values = np.array([0.0, 0.0, 0.0, self.start_throttle])
+        self._start(np.array([0.0, 0.0, 0.0, self.start_throttle]))
 
     def start_from(self, action: np.ndarray) -> None:
         """Hold the aircraft's start controls (a trimmed start's trim) until the pilot moves."""
-        self.values = np.array(action, dtype=np.float64)
+        self._start(np.array(action, dtype=np.float64))
+
+    def _start(self, values: np.ndarray) -> None:
+        self.values = values
         self.held.clear()
         if self.cockpit is not None:  # FlightGear's stick stays where the person holds it
             self.cockpit.poll()
