@@ -36,6 +36,9 @@ class EnvConfig:
             FlightGear aircraft heard on its port is an opponent (position and orientation
             only), our aircraft are sent to its ``send_to`` addresses, and the simulation
             paces itself to real time, FlightGear's clock.
+        trimmed_starts: the tasks' and the scenario's starts are trimmed straight, level
+            flight (the default); False starts them untrimmed, as before trimmed starts
+            existed (initial conditions given at reset keep their own ``trimmed``).
     """
 
     sim_hz: int = DEFAULT_SIM_HZ
@@ -46,6 +49,7 @@ class EnvConfig:
     traffic: Mapping[str, Sequence[int]] | None = None
     weather: Weather = field(default_factory=Weather)
     multiplayer: MultiplayerConfig | None = None
+    trimmed_starts: bool = True
 
     def __post_init__(self) -> None:
         substeps(self.sim_hz, self.agent_hz)
@@ -73,6 +77,8 @@ class EnvConfig:
                     f"opponent_view {list(unseen)}: FlightGear aircraft show only "
                     f"{list(POSITION + ORIENTATION)}; drop the others or the multiplayer"
                 )
+        if not isinstance(self.trimmed_starts, bool):
+            raise ConfigError(f"trimmed_starts={self.trimmed_starts!r} must be True or False")
         if self.scenario is not None and not callable(self.scenario):
             raise ConfigError(
                 f"scenario must be callable (rng, aircraft) -> ics, got {self.scenario!r}"

@@ -65,6 +65,9 @@ class FlightSpec:
             episode; ``sim.weather``).
         wind_kt: a steady wind (knots).
         wind_from_deg: where the wind blows from (true; None: drawn per episode).
+        trimmed_starts: the tasks' and scenarios' starts are trimmed straight, level flight
+            (``sim.initial.InitialConditions.trimmed``). A record without it was flown before
+            trimmed starts existed and reads as False, so its episodes replay as flown.
     """
 
     teams: tuple[TeamSpec, ...] = field(default_factory=_default_teams)
@@ -76,6 +79,7 @@ class FlightSpec:
     turbulence: Turbulence = "none"
     wind_kt: float = 0.0
     wind_from_deg: float | None = None
+    trimmed_starts: bool = True
 
     def __post_init__(self) -> None:
         problems: list[str] = []
@@ -131,6 +135,7 @@ class FlightSpec:
         turbulence: Turbulence = "none",
         wind_kt: float = 0.0,
         wind_from_deg: float | None = None,
+        trimmed_starts: bool = True,
     ) -> FlightSpec:
         """One aircraft, callsign ``ego``, flying one task (what the gymnasium env flies);
         ``episode_time_s`` defaults to the task's own (90 s for most, longer for the
@@ -141,7 +146,7 @@ class FlightSpec:
         teams = (TeamSpec("ego", (ego,)),)
         return cls(
             teams, agent_hz, sim_hz, episode_time_s, DEFAULT_OPPONENT_VIEW, None, turbulence,
-            wind_kt, wind_from_deg,
+            wind_kt, wind_from_deg, trimmed_starts,
         )  # fmt: skip
 
     @property
@@ -224,6 +229,7 @@ class FlightSpec:
             "turbulence": self.turbulence,
             "wind_kt": self.wind_kt,
             "wind_from_deg": self.wind_from_deg,
+            "trimmed_starts": self.trimmed_starts,
         }
 
     def to_json(self) -> str:
@@ -267,6 +273,7 @@ class FlightSpec:
         except (KeyError, TypeError) as err:
             raise ConfigError(f"flight spec record is malformed ({err!r})") from None
         settings = {k: data[k] for k in known - {"version", "teams"} if k in data}
+        settings.setdefault("trimmed_starts", False)  # recorded before trimmed starts existed
         if "opponent_view" in settings:
             settings["opponent_view"] = tuple(settings["opponent_view"])
         return cls(teams, **settings)
@@ -307,6 +314,7 @@ class FlightSpec:
             weather.turbulence,
             weather.wind_kt,
             weather.wind_from_deg,
+            config.trimmed_starts,
         )
 
     def rebuild_problems(self) -> list[str]:
@@ -365,6 +373,7 @@ class FlightSpec:
             views,
             traffic,
             self.weather,
+            trimmed_starts=self.trimmed_starts,
         )
 
     def make_world(

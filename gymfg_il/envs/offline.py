@@ -49,6 +49,8 @@ class OfflineEnv:
             ``send_to`` addresses. While it is set, ``step`` keeps to the wall clock (one
             step per ``1 / agent_hz`` seconds), because a person's aircraft flies in real
             time.
+        trimmed_starts: trimmed straight, level starts (the default), or untrimmed ones:
+            see ``EnvConfig``.
 
     ``reset(team)`` returns ``(team_state, opponent_states)``: one observation (float32) per
     aircraft of ``team`` in roster order, and an ``(n, len(opponent_view))`` array of what the
@@ -80,6 +82,7 @@ class OfflineEnv:
         traffic: Mapping[str, Sequence[int]] | None = None,
         weather: Weather | None = None,
         multiplayer: MultiplayerConfig | None = None,
+        trimmed_starts: bool = True,
     ) -> None:
         self.config = EnvConfig(
             sim_hz,
@@ -90,6 +93,7 @@ class OfflineEnv:
             traffic,
             weather or Weather(),
             multiplayer,
+            trimmed_starts,
         )
         self.opponents: list[tuple[Team, list[Agent]]] = []
         for entry in opponents:

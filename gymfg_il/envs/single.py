@@ -45,6 +45,8 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
             attached the env runs at real time.
         turbulence, wind_kt, wind_from_deg: the weather (``sim.weather``): JSBSim's
             turbulence (none, light, moderate, severe) and a steady wind, seeded per episode.
+        trimmed_starts: start each episode in trimmed straight, level flight, the controls
+            at the trim (the default; ``sim.trim``), or untrimmed with centred surfaces.
         render_mode: ``None``, ``"rgb_array"`` (``render()`` returns the camera's frame,
             (height, width, 3) uint8) or ``"human"`` (a window shows it at every reset and
             step, paced to real time at ``metadata["render_fps"]`` = ``agent_hz``).
@@ -84,6 +86,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         turbulence: Turbulence = "none",
         wind_kt: float = 0.0,
         wind_from_deg: float | None = None,
+        trimmed_starts: bool = True,
         camera: str = "front",
         render_size: tuple[int, int] = (128, 128),
     ) -> None:
@@ -105,6 +108,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
                 turbulence=turbulence,
                 wind_kt=wind_kt,
                 wind_from_deg=wind_from_deg,
+                trimmed_starts=trimmed_starts,
             )
             team = flight.build_teams()[0]
         else:
@@ -127,6 +131,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
                 agent_hz=agent_hz,
                 views={"ego": list(views)} if views else None,
                 weather=Weather(turbulence, wind_kt, wind_from_deg),
+                trimmed_starts=trimmed_starts,
             ),
         )
         self.flight = flight or FlightSpec.of_world(self.world)
@@ -161,6 +166,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
             turbulence=flight.turbulence,
             wind_kt=flight.wind_kt,
             wind_from_deg=flight.wind_from_deg,
+            trimmed_starts=flight.trimmed_starts,
             **kwargs,
         )
 

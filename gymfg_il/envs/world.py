@@ -7,6 +7,7 @@ clock; it knows nothing about who chooses the actions.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import time
@@ -226,6 +227,7 @@ class World:
         if scenario is not None:
             joint = np.random.default_rng([base, 0])
             ics.update(scenario(joint, [(s.team, s.aircraft) for s in self.slots]))
+            ics = {c: self._start(ic) for c, ic in ics.items()}
         ics.update(overrides or {})
         unknown = set(ics) - set(self.by_callsign)
         if unknown:
@@ -237,7 +239,7 @@ class World:
             # the air gets a stream of its own: calm episodes draw exactly what they always did
             air = weather.draw(np.random.default_rng([base, 2, key]))
             own = np.random.default_rng([base, 1 + key])
-            ic = ics.get(slot.callsign) or slot.task.initial_conditions(own)
+            ic = ics.get(slot.callsign) or self._start(slot.task.initial_conditions(own))
             throttle = slot.aircraft.profile.cruise_throttle
             try:
                 slot.state = slot.prev_state = slot.sim.reset(ic, throttle, air)
@@ -257,6 +259,12 @@ class World:
             self.displays.show()
         if self.link is not None:
             self._exchange()
+
+    def _start(self, ic: InitialConditions) -> InitialConditions:
+        """A drawn start as the config asks: untrimmed when ``trimmed_starts`` is off."""
+        if self.config.trimmed_starts or not ic.trimmed:
+            return ic
+        return dataclasses.replace(ic, trimmed=False)
 
     def advance(self, actions: Sequence[Controls | None]) -> None:
         """Apply one action per slot (None for terminated aircraft), step, score, check ends."""

@@ -101,3 +101,23 @@ def test_near_the_envelope_the_start_itself_is_trimmed():
     sim.reset(InitialConditions(altitude_ft=8200.0, airspeed_kts=110.0, trimmed=True), 0.75)
     assert sim.trim == trim
     assert _hands_off(sim)[0] < 50.0
+
+
+def test_untrimmed_starts_remain_a_setting_and_old_records_replay_untrimmed():
+    from gymfg_il.envs import AircraftEnv, FlightSpec
+
+    spec = FlightSpec.solo("c172p", "altitude")
+    assert spec.trimmed_starts and FlightSpec.from_json(spec.to_json()) == spec
+    old = spec.to_dict()
+    del old["trimmed_starts"]  # a record written before trimmed starts existed
+    assert not FlightSpec.from_dict(old).trimmed_starts
+    alphas = {}
+    for trimmed in (True, False):
+        env = AircraftEnv.from_flight(spec.replace(trimmed_starts=trimmed))
+        env.reset(seed=3)
+        sim = env.world.slots[0].sim
+        alphas[trimmed] = sim.fdm["aero/alpha-deg"]
+        assert (sim.trim is not None) == trimmed
+        assert env.world.slots[0].action[3] == pytest.approx(sim.start_action[3])
+        env.close()
+    assert alphas[True] > 0.3 and alphas[False] == pytest.approx(0.0, abs=1e-6)
