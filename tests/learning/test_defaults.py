@@ -43,4 +43,5 @@ def test_train_says_when_validation_loss_is_far_above_training_loss(tmp_path):
     # default noise from trimmed starts: one held-out episode's throttle and elevator follow
     # integrals the task does not observe, yet the policy flew 16 of 16 held-out episodes
     assert result(0.0255, 0.2587).overfit == ""
+    assert result(0.0167, 0.3363).overfit == ""  # the same with the trim in the controls: 20x
     assert result(0.0001, 0.0004).overfit == ""  # both tiny: nothing worth a warning
