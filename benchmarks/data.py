@@ -27,6 +27,7 @@ def dataset_build(episodes: int) -> Row:
     from gymfg_il.datasets.features import dataset_features
     from gymfg_il.datasets.from_logs import build_from_logs, episode_columns
     from gymfg_il.recording.reader import read_log
+    from gymfg_il.sim.properties import task_columns
 
     tmp = Path(tempfile.mkdtemp(prefix="gymfg-bench-"))
     try:
@@ -45,13 +46,16 @@ def dataset_build(episodes: int) -> Row:
             root=tmp / "stock",
             use_videos=False,
         )
+        env_cols = task_columns(ego["observation_names"])  # the task's own columns
         frames = 0
         for ep in log.complete_episodes:
             cols = episode_columns(ep, "ego")
             for i in range(len(cols["action"])):
+                state = cols["observation.state"][i].astype(np.float32)
                 ds.add_frame(
                     {
-                        "observation.state": cols["observation.state"][i].astype(np.float32),
+                        "observation.state": state,
+                        "observation.environment_state": np.ascontiguousarray(state[env_cols]),
                         "action": cols["action"][i].astype(np.float32),
                         "next.reward": np.array([cols["next.reward"][i]], np.float32),
                         "next.done": np.array([cols["next.done"][i]]),
