@@ -373,6 +373,16 @@ class World:
             s for s in self.slots if s.team != team and (not present_only or s.present(self.steps))
         ]
 
+    def show_peers_as(self, view: Sequence[str]) -> None:
+        """Show FlightGear aircraft with these columns from now on (an online server
+        announces its own opponent view); each must be a position or orientation variable."""
+        pose = POSITION + ORIENTATION
+        self._peer_cols = [pose.index(v) for v in view]
+
+    def peer_row(self, callsign: str) -> np.ndarray:
+        """What an opponent sees of the FlightGear aircraft ``callsign`` (one heard now)."""
+        return np.take(self.peers[callsign].pose, self._peer_cols)
+
     def opponent_callsigns(self, team: str, present_only: bool = False) -> list[str]:
         """Who the rows of ``opponent_states`` are: ``opponents_of``, then the FlightGear
         aircraft heard (by callsign)."""
@@ -383,7 +393,7 @@ class World:
         """What ``team`` sees of other teams' aircraft: (n, len(opponent_view)) float64, in
         the order of ``opponent_callsigns``: this simulation's, then FlightGear's."""
         rows = [s.state[self.view_idx] for s in self.opponents_of(team, present_only)]
-        rows += [np.take(self.peers[c].pose, self._peer_cols) for c in sorted(self.peers)]
+        rows += [self.peer_row(c) for c in sorted(self.peers)]
         if not rows:
             return np.zeros((0, len(self.view_idx)))
         return np.stack(rows)

@@ -27,6 +27,7 @@ from gymfg_il.online.protocol import ProtocolError, ServerError, decode, encode
 from gymfg_il.online.threads import first_socket
 from gymfg_il.sim.properties import ORIENTATION, POSITION
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
+from gymfg_il.viz.peers import MultiplayerConfig
 
 _LEAVE_LINGER_MS = 250
 log = logging.getLogger(__name__)
@@ -61,10 +62,24 @@ class OnlineEnv:
         batch_io: run this client's ZeroMQ I/O thread under Linux's SCHED_BATCH policy and
             yield the CPU right after each report, so the report leaves at once while the
             thread never preempts the env elsewhere (see ``gymfg_il.online.threads``).
+        multiplayer: FlightGear multiplayer (``MultiplayerConfig``): people flying FlightGear
+            join as opponents of this team, as in ``OfflineEnv``. This client listens on
+            ``listen_port`` itself (each client that sets it needs a port of its own) and
+            sends its own aircraft to ``send_to``; the server does not relay FlightGear
+            aircraft to the other teams (a team that wants them sets its own
+            ``multiplayer``). The client then keeps to the wall clock (real time), and so
+            holds the whole lockstep to it. The server's opponent view must be position and
+            orientation variables only (all a FlightGear aircraft shows): ``reset`` raises
+            ``ConfigError`` otherwise.
 
     ``reset`` and ``step`` return what ``OfflineEnv`` returns; ``truncated`` also becomes True
     when the server ends the simulation (in a k-fixed simulation, when any team completes),
     with ``info["server_reason"]``.
+
+    With ``multiplayer``, the FlightGear aircraft heard follow the server's rows in
+    ``opponent_states`` (sorted by callsign; ``info["opponent_callsigns"]`` names every row),
+    are reward targets by callsign, and leave after ``timeout_s`` of silence. A callsign
+    the server relays is shown as the server has it, not as FlightGear echoes it.
     """
 
     def __init__(
@@ -81,6 +96,7 @@ class OnlineEnv:
         cpu: int | None = None,
         spin_us: float = 1000.0,
         batch_io: bool = True,
+        multiplayer: MultiplayerConfig | None = None,
     ) -> None:
         import zmq
 
@@ -97,7 +113,9 @@ class OnlineEnv:
         self._spin_s = spin_us * 1e-6
         self._wait_s = 0.0  # moving average of the wait for a reply
         self._clock = time.perf_counter
-        self.config = EnvConfig(sim_hz, agent_hz, views=views, traffic=traffic)
+        self.config = EnvConfig(
+            sim_hz, agent_hz, views=views, traffic=traffic, multiplayer=multiplayer
+        )
         self._affinity: set[int] | None = None  # the calling thread's, while pinned
         if cpu is not None:
             available = os.sched_getaffinity(0)
@@ -204,6 +222,21 @@ class OnlineEnv:
         aircraft = {a.callsign: a.model for a in self.team.aircraft}
         return self._request({"type": "join", "aircraft": aircraft}, "welcome")
 
+    def _show_peers(self) -> None:
+        """FlightGear aircraft in the server's opponent view: position and orientation only."""
+        assert self.world is not None
+        pose = POSITION + ORIENTATION
+        extra = [n for n in self.view if n not in pose]
+        if extra:
+            self.joined = True  # the server has the team: tell it the team leaves
+            self.leave()
+            raise ConfigError(
+                f"the server at {self.address} shows opponents' {extra}, which FlightGear "
+                f"aircraft do not send (they show only {list(pose)}); use a server whose "
+                "--view is position and orientation variables, or drop multiplayer"
+            )
+        self.world.show_peers_as(self.view)
+
     def _states(self) -> dict[str, list[float]]:
         assert self.world is not None
         return {s.callsign: s.state.tolist() for s in self.world.slots}
@@ -215,6 +248,10 @@ class OnlineEnv:
         rows = central["opponents"]
         self.opponents = [r[0] for r in rows]
         assert self.world is not None
+        # FlightGear aircraft this client hears, after the server's (which win a shared name)
+        relayed = set(self.opponents)
+        peers = [c for c in sorted(self.world.peers) if c not in relayed]
+        self.opponents += peers
         if self._pose_at is not None and self.world.traffic:  # shown in the team's views
             others = self.world.others
             others.clear()
@@ -229,11 +266,17 @@ class OnlineEnv:
                     view.values = np.asarray(values, dtype=np.float64)
                     shown.add(callsign)
             for callsign, view in external.items():  # not shown: absent from ctx.targets
-                if callsign not in shown:
+                if callsign in shown:
+                    continue
+                if callsign in self.world.peers:  # heard from FlightGear
+                    view.values = self.world.peer_row(callsign)
+                else:
                     view.values = np.full(len(view.values), np.nan)
-        if not rows:
+        table = [np.asarray(r[2], dtype=np.float64) for r in rows]
+        table += [self.world.peer_row(c) for c in peers]
+        if not table:
             return np.zeros((0, len(self.view)))
-        return np.array([r[2] for r in rows], dtype=np.float64)
+        return np.stack(table)
 
     # -- API -----------------------------------------------------------------------------
     def reset(
@@ -254,6 +297,8 @@ class OnlineEnv:
         if not self.joined:
             welcome = self._join()
             self.view = tuple(welcome["opponent_view"])
+            if self.config.multiplayer is not None:
+                self._show_peers()
             if self.view != tuple(self.config.opponent_view):  # the server decides
                 for view in self.world.external.values():
                     view.rename(self.view)

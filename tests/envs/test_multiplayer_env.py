@@ -103,3 +103,64 @@ def test_a_taken_port_is_a_config_error_naming_it():
         env = OfflineEnv(multiplayer=MultiplayerConfig(listen_port=port))
         with pytest.raises(ConfigError, match=f"127.0.0.1:{port}"):
             env.configure(Team("blue", [(c172p("ego"), DummyTask)]))
+
+
+def test_the_pettingzoo_env_shows_flightgear_aircraft_to_every_team_until_they_fall_silent():
+    from pettingzoo.test import parallel_api_test
+
+    from gymfg_il.aircraft import f15
+    from gymfg_il.envs import parallel_env
+
+    listen, fg_in = free_udp_ports(2)
+    seen = []
+
+    def note_person(ctx):
+        view = ctx.targets.get("person")
+        seen.append(None if view is None else view.values.copy())
+        return 0.0
+
+    red1_ = f15("red1")
+    red = Team(
+        "red",
+        [(red1_, DummyTask(reward=note_person))],
+        reward_function_targets={red1_: [c172p("person")]},
+    )
+    blue = Team("blue", [(c172p("blue1"), DummyTask)])
+    config = MultiplayerConfig(listen_port=listen, send_to=[("127.0.0.1", fg_in)], timeout_s=0.5)
+    fg = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    fg.bind(("127.0.0.1", fg_in))
+    fg.settimeout(5)
+    person = mp.TrafficSender([listen])
+    # callsigns of 7 characters at most: FlightGear keeps no more
+    env = parallel_env([red, blue], agent_hz=30, multiplayer=config)  # listens from here on
+    try:
+        person.send("person", "c172p", PERSON)
+        time.sleep(0.05)
+        obs, infos = env.reset(seed=0)
+        for agent, other in (("red1", "blue1"), ("blue1", "red1")):
+            assert obs[agent]["opponents"].shape == (2, 6)  # the other team, then the person
+            assert obs[agent]["opponents"][1] == pytest.approx(PERSON, abs=1e-4)
+            assert obs[agent] in env.observation_space(agent)
+            assert infos[agent]["opponent_callsigns"] == [other, "person"]
+        assert {peers.decode(fg.recv(4096)).callsign for _ in range(2)} == {"red1", "blue1"}
+        action = np.array([0.0, 0.0, 0.0, 0.7])
+        t0 = time.perf_counter()
+        for _ in range(9):
+            person.send("person", "c172p", PERSON)
+            obs, rewards, *_, infos = env.step(dict.fromkeys(env.agents, action))
+            assert infos["blue1"]["opponent_callsigns"] == ["red1", "person"]
+        assert 0.25 < time.perf_counter() - t0 < 0.6  # 9 steps at 30 Hz: real time
+        assert seen[-1] == pytest.approx(PERSON, abs=1e-4)
+        for _ in range(30):  # 1 s of silence: dropped after 0.5 s
+            obs, rewards, *_, infos = env.step(dict.fromkeys(env.agents, action))
+        assert obs["blue1"]["opponents"].shape == (1, 6)
+        assert obs["blue1"] in env.observation_space("blue1")
+        assert infos["red1"]["opponent_callsigns"] == ["blue1"]
+        assert seen[-1] is None and all(np.isfinite(r) for r in rewards.values())
+        person.send("person", "c172p", PERSON)  # heard again: PettingZoo's own checks pass
+        time.sleep(0.05)
+        parallel_api_test(env, num_cycles=20)
+    finally:
+        env.close()
+        person.close()
+        fg.close()
