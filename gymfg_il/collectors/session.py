@@ -86,6 +86,15 @@ def check_appendable(
         return
     mine = flight.replace(episode_time_s=1.0)  # episode times may differ
     theirs = {FlightSpec.from_json(s).replace(episode_time_s=1.0) for s in episodes["gymfg/spec"]}
+    starts = {spec.trimmed_starts for spec in theirs}
+    if mine.trimmed_starts not in starts:
+        raise ConfigError(
+            f"the dataset at {root} holds episodes flown from "
+            f"{'trimmed' if True in starts else 'untrimmed'} starts (an older dataset: trimmed "
+            "starts are the default since 2026-11-25); these would start "
+            f"{'trimmed' if mine.trimmed_starts else 'untrimmed'} and mix two kinds of opening "
+            "in one dataset: collect into a new --out folder"
+        )
     if theirs - {mine}:
         log.warning(
             "the dataset at %s holds episodes of another flight (aircraft, task, options or "

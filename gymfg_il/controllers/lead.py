@@ -7,6 +7,8 @@ of these (``World`` does, for any task with ``needs_lead_pilot``).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from gymfg_il.controllers.autopilot import Autopilot, Targets
@@ -27,8 +29,11 @@ class LeadPilot:
     """Fly a lead of ``model`` at ``dt`` seconds per step, JSBSim at ``sim_hz`` (its
     simulation is kept across episodes)."""
 
-    def __init__(self, model: str, dt: float, sim_hz: int = DEFAULT_SIM_HZ) -> None:
+    def __init__(
+        self, model: str, dt: float, sim_hz: int = DEFAULT_SIM_HZ, trimmed: bool = True
+    ) -> None:
         self.model, self.dt = model, dt
+        self.trimmed = trimmed  # the flight's trimmed_starts: the lead starts as the rest do
         self.sim = Simulation(model, sim_hz, round(1.0 / dt))
         self._own = indices(OWN)
 
@@ -47,6 +52,8 @@ class LeadPilot:
         pilot = Autopilot(_NAMES, self.model, self.dt, targets)
         pilot.set_throttle_trim(throttle)
         sim = self.sim
+        if ic.trimmed != self.trimmed:
+            ic = dataclasses.replace(ic, trimmed=self.trimmed)
         state = sim.reset(ic, throttle)
         pilot.start_from(np.array(sim.start_action))
         track = np.empty((len(altitude_targets), len(view)))

@@ -239,4 +239,7 @@ class DatasetBuilder:
         self.meta.finalize()
         from gymfg_il.datasets.card import write_card
 
-        write_card(self.root, self.repo_id, shown_root=card_root, meta=self.meta)
+        try:  # the card describes the data: a card it cannot write costs no finished build
+            write_card(self.root, self.repo_id, shown_root=card_root, meta=self.meta)
+        except (ValueError, KeyError, TypeError, OSError) as err:
+            log.warning("dataset %s: no card written (%s)", self.root, err)

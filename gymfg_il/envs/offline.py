@@ -157,9 +157,13 @@ class OfflineEnv:
         if options:
             raise ConfigError(f"unknown reset options {sorted(options)}; known: initial_conditions")
         self.world.reset(self._rng, overrides)
-        for _, agents in self.opponents:
-            for agent in agents:
+        for opponent, agents in self.opponents:
+            slots = self.world.team_slots[opponent.name]
+            for agent, slot in zip(agents, slots, strict=True):
                 agent.reset(int(self._rng.integers(2**31)))
+                start = getattr(agent, "start_from", None)
+                if start is not None:  # a controller starts from the trim the aircraft has
+                    start(slot.action)
         self._done = False
         return self._team_state(), self.world.opponent_states(self.team.name, present_only=True)
 

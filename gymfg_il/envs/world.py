@@ -31,6 +31,7 @@ from gymfg_il.sim.simulation import Simulation
 from gymfg_il.sim.timing import episode_steps
 from gymfg_il.tasks.base import Task
 from gymfg_il.tasks.rewards import RewardContext
+from gymfg_il.viz.multiplayer import CALLSIGN_BYTES
 from gymfg_il.viz.peers import MultiplayerLink, Peer
 
 log = logging.getLogger(__name__)
@@ -147,7 +148,9 @@ class World:
                 task = build_task(spec, f"team {team.name!r}, aircraft {aircraft.callsign!r}")
                 task.bind(aircraft, self.dt, self.max_steps)
                 if getattr(task, "needs_lead_pilot", False) and task.lead_pilot is None:  # type: ignore[attr-defined]
-                    task.lead_pilot = LeadPilot(aircraft.model, self.dt, config.sim_hz)  # type: ignore[attr-defined]
+                    task.lead_pilot = LeadPilot(  # type: ignore[attr-defined]
+                        aircraft.model, self.dt, config.sim_hz, config.trimmed_starts
+                    )
                 sim = self.pool.take(aircraft.model)
                 self.slots.append(Slot(len(self.slots), team.name, aircraft, task, sim))
         self.by_callsign = {s.callsign: s for s in self.slots}
@@ -160,7 +163,13 @@ class World:
         self.link: MultiplayerLink | None = None
         self.peers: dict[str, Peer] = {}  # FlightGear aircraft heard, by callsign
         self._pose_idx = indices(POSITION + ORIENTATION)
-        self._peer_cols = [(POSITION + ORIENTATION).index(v) for v in config.opponent_view]
+        # which pose columns an opponent sees of a FlightGear aircraft (multiplayer only: its
+        # config refuses a view beyond position and orientation)
+        self._peer_cols = (
+            [(POSITION + ORIENTATION).index(v) for v in config.opponent_view]
+            if config.multiplayer is not None
+            else []
+        )
         self._next_frame = 0.0
         if config.multiplayer is not None:
             self.link = MultiplayerLink(config.multiplayer)
@@ -301,7 +310,9 @@ class World:
             if slot.present(self.steps) and np.isfinite(pose).all():
                 link.send(slot.callsign, slot.aircraft.model, pose)
         # a server may echo our own aircraft back: they are not FlightGear's
-        self.peers = {c: p for c, p in link.poll().items() if c not in self.by_callsign}
+        # (compared as sent: FlightGear keeps 7 characters of a callsign)
+        ours = {c[: CALLSIGN_BYTES - 1] for c in self.by_callsign}
+        self.peers = {c: p for c, p in link.poll().items() if c not in ours}
         for callsign, view in self.external.items():
             peer = self.peers.get(callsign)
             view.values[:] = np.nan if peer is None else np.take(peer.pose, self._peer_cols)

@@ -116,6 +116,7 @@ def env_spec(flight: FlightSpec) -> Any:
         "turbulence": flight.turbulence,
         "wind_kt": flight.wind_kt,
         "wind_from_deg": flight.wind_from_deg,
+        "trimmed_starts": flight.trimmed_starts,
     }
     import json
 
@@ -173,12 +174,22 @@ class _FlownActions:
             for ep in self._read[name].complete_episodes:
                 if ep.index == index and callsign in ep.steps:
                     return ep.steps[callsign].action, True
-        if float(meta.get("gymfg/noise", 0.0) or 0.0) > 0.0:
+        noisy = float(meta.get("gymfg/noise", 0.0) or 0.0) > 0.0
+        # the action column holds the demonstrator's label: under DAgger the policy flew and
+        # the expert labelled, so what flew is only in the log
+        relabelled = "dagger" in str(meta.get("gymfg/source", ""))
+        if noisy or relabelled:
+            why = (
+                f"flown with noise {meta['gymfg/noise']}"
+                if noisy
+                else f"labelled by a demonstrator that did not fly it (source "
+                f"{meta.get('gymfg/source')!r})"
+            )
             raise ConfigError(
-                f"episode {meta['episode_index']} was flown with noise "
-                f"{meta['gymfg/noise']}: its flown actions are only in its log {name}, which "
-                f"is not under {self.logs or 'a logs/ folder beside the dataset'}; export the "
-                "session folder that holds it"
+                f"episode {meta['episode_index']} was {why}: its flown actions are only in "
+                f"its log {name}, which is not under "
+                f"{self.logs or 'a logs/ folder beside the dataset'}; export the session "
+                "folder that holds it"
             )
         return labels.astype(np.float64), False
 

@@ -38,6 +38,13 @@ class Takeover:
         if self.assistant is not None:
             self.assistant.reset(seed)
 
+    def start_from(self, action: np.ndarray) -> None:
+        """The person's stick and the assistant start from the aircraft's start controls."""
+        self.human.start_from(action)
+        start = getattr(self.assistant, "start_from", None)
+        if start is not None:
+            start(action)
+
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
         if self.human_flies:
             action = self.human.act(observation)

@@ -114,7 +114,8 @@ def index_problems(path: Path) -> list[str]:
     with open(path, "rb") as f:
         summary = _summary(f, path)
         problems = []
-        if not summary.chunk_indexes:
+        empty = summary.statistics is not None and summary.statistics.message_count == 0
+        if not summary.chunk_indexes and not empty:  # a log with no message has no chunk
             problems.append("no chunk indexes")
         bare = sum(1 for ci in summary.chunk_indexes if not ci.message_index_offsets)
         if bare:

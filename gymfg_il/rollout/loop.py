@@ -114,9 +114,10 @@ def team_views(
         if own is not None and team == own[0]:
             views[team] = OpponentView(list(own[1]), names, np.asarray(own[2], np.float64))
             continue
-        others = world.opponents_of(team, present_only=True)
+        # the rows name this simulation's opponents, then the FlightGear aircraft heard
+        callsigns = world.opponent_callsigns(team, present_only=True)
         rows = world.opponent_states(team, present_only=True)
-        views[team] = OpponentView([s.callsign for s in others], names, rows)
+        views[team] = OpponentView(callsigns, names, rows)
     return views
 
 

@@ -153,6 +153,8 @@ def decode(data: bytes, heard_at: float = 0.0) -> Peer:
     if length > len(data):
         raise MessageError(f"message says {length} bytes, {len(data)} arrived")
     model, time_s, _lag, x, y, z, ox, oy, oz, vx, vy, vz = _BODY_HEAD.unpack_from(data, HEADER.size)
+    if not all(math.isfinite(v) for v in (time_s, x, y, z, ox, oy, oz, vx, vy, vz)):
+        raise MessageError("a position message with a non-finite position, angle or velocity")
     lat, lon, alt = geodetic(x, y, z)
     roll, pitch, heading = attitude((ox, oy, oz), lat, lon)
     return Peer(
@@ -203,6 +205,12 @@ class MultiplayerConfig:
         problem = port_problem(self.listen_port)
         if problem:
             problems.append(f"listen_port: {problem}")
+        bad = [a for a in self.send_to if not (isinstance(a, (tuple, list)) and len(a) == 2)]
+        if bad:
+            raise ConfigError(
+                f"multiplayer: send_to entries must be (host, port) pairs, got {bad!r}; "
+                'e.g. send_to=[("127.0.0.1", 5000)]'
+            )
         send_to = tuple((str(h), p) for h, p in self.send_to)
         object.__setattr__(self, "send_to", send_to)
         problems += [f"send_to {h}: {p}" for h, port in send_to if (p := port_problem(port))]

@@ -168,3 +168,18 @@ def test_running_a_recipe_again_remakes_its_dataset_instead_of_doubling_it(tmp_p
     assert LeRobotDataset("x/y", root=tmp_path / "s" / "dataset").num_episodes == 2
     assert collect.main([str(recipe), "--episodes", "3", "--no-progress"]) == 0  # one more
     assert LeRobotDataset("x/y", root=tmp_path / "s" / "dataset").num_episodes == 3
+
+
+def test_an_untrimmed_dataset_takes_no_trimmed_episodes(tmp_path):
+    from gymfg_il.collectors.session import check_appendable
+    from gymfg_il.envs import FlightSpec
+    from gymfg_il.errors import ConfigError
+
+    out = tmp_path / "s"
+    argv = ["autopilot", "--task", "roll", "--episodes", "1", "--episode-time", "2"]
+    assert collect.main([*argv, "--out", str(out), "--no-progress"]) == 0
+    trimmed = FlightSpec.solo("c172p", "roll")
+    names = trimmed.build_teams()[0].roster[0][1]().observation_names
+    check_appendable(out, names, 10, trimmed)  # the same flight: fine
+    with pytest.raises(ConfigError, match=r"trimmed starts.*new --out"):
+        check_appendable(out, names, 10, trimmed.replace(trimmed_starts=False))

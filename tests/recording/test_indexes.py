@@ -83,6 +83,15 @@ def test_an_indexed_log_is_left_untouched(old_log, tmp_path):
     assert path.read_bytes() == data and path.stat().st_mtime_ns == stat.st_mtime_ns
 
 
+def test_a_log_without_messages_is_left_untouched(tmp_path):
+    path = tmp_path / "quit-before-flying.mcap"  # a session quit before its first episode
+    session = {"callsigns": ["ego"], "aircraft": {"ego": {"team": "ego"}}, "dt": 0.1}
+    writer.TrajectoryWriter(path, session).close()
+    data = path.read_bytes()
+    assert index_problems(path) == []
+    assert not reindex(path).changed and path.read_bytes() == data
+
+
 def test_damaged_and_cut_logs_are_refused_and_left_as_they_were(old_log, tmp_path):
     data = old_log.read_bytes()
     with open(old_log, "rb") as f:

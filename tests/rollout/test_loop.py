@@ -127,3 +127,38 @@ def test_when_a_team_crashes_the_others_are_cut_short_and_the_outcome_says_why()
     # the last observation of each aircraft is the one its own last step led to
     assert not np.array_equal(red_t.final_observation, red_t.observations[-1])
     env.close()
+
+
+def test_every_pilot_starts_from_the_trim_it_is_handed():
+    """The controls a trimmed start begins with reach the person's stick, the assistant
+    beside them, and the autopilots the env flies for its own opponents: none opens with a
+    step away from the trim."""
+    from gymfg_il.manual.controller import ManualController
+    from gymfg_il.manual.takeover import Takeover
+
+    env = AircraftEnv("altitude", "c172p")
+    assist = controller_for(env.task, "c172p", env.dt)
+    takeover = Takeover(ManualController("keyboard"), assist)
+    rollout = Rollout(env, [takeover])
+    rollout.reset(3)
+    start = env.world.slots[0].action
+    assert start[1] != 0.0  # the trim's elevator
+    assert np.array_equal(takeover.human.values, start)
+    assert assist.pitch_pid.bias == -start[1] and assist.throttle_trim == start[3]
+    env.close()
+
+    red = Team("red", [(c172p("red-1"), ReachStaticTargetAltitudeTask)])
+    blue = Team("blue", [(c172p("blue-1"), ReachStaticTargetAltitudeTask)])
+    opponent = controller_for(ReachStaticTargetAltitudeTask(), "c172p", 0.1)
+    offline = OfflineEnv([(blue, [opponent])])
+    offline.reset(red, seed=1)
+    theirs = offline.world.by_callsign["blue-1"].action
+    assert opponent.pitch_pid.bias == -theirs[1] and opponent.throttle_trim == theirs[3]
+
+
+def test_an_opponent_view_beyond_the_pose_works_without_multiplayer():
+    red = Team("red", [(c172p("red-1"), ReachStaticTargetAltitudeTask)])
+    blue = Team("blue", [(c172p("blue-1"), ReachStaticTargetAltitudeTask)])
+    env = OfflineEnv([(blue, [ConstantAgent()])], opponent_view=("altitude_ft", "airspeed_kts"))
+    _, opponents = env.reset(red, seed=0)
+    assert opponents.shape == (1, 2) and opponents[0, 1] > 50.0
