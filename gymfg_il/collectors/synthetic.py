@@ -78,6 +78,7 @@ class SyntheticDriver:
         if session.episode != self._episode:  # a new episode: a fresh pilot, its own seed
             self._episode = session.episode
             self.pilot.reset(session.next_seed)
+            self.pilot.start_from(session.human.start_controls)
             self._settled = 0.0
         if session.pilot.assistant is not None:
             self._gate(session)

@@ -5,6 +5,11 @@ controls as they stand. Keyboard and joystick state is built from events (KEYDOW
 JOYAXISMOTION, ...), never from polling, so injected events drive it exactly like real ones.
 The ``flightgear`` device reads FlightGear's controls stream instead (``manual.cockpit``),
 at every ``handle`` and ``act``.
+
+The stick's neutral is the episode's start controls (``start_from``: a trimmed start's trim),
+as trim sets a real stick's neutral: released keys centre the surfaces on it, the mouse
+pointer and the joystick deflect from it, and the centre key returns to it. The action is
+still the whole command (neutral plus deflection), so a hands-off pilot flies the trim.
 """
 
 from __future__ import annotations
@@ -67,6 +72,8 @@ class ManualController:
         self.start_throttle = throttle
         self.window_size = window_size
         self.values = np.array([0.0, 0.0, 0.0, throttle])
+        self.start_controls = self.values.copy()  # this episode's (a trimmed start's trim)
+        self.neutral: np.ndarray = np.zeros(3)  # the surfaces' neutral: the start controls
         self.held: set[str] = set()
         self.joysticks: dict[int, Any] = {}  # instance id -> pygame Joystick (or None)
         self.status = ""
@@ -107,6 +114,8 @@ class ManualController:
 
     def _start(self, values: np.ndarray) -> None:
         self.values = values
+        self.start_controls = values.copy()
+        self.neutral = values[:3].copy()
         self.held.clear()
         if self.cockpit is not None:  # FlightGear's stick stays where the person holds it
             self.cockpit.poll()
@@ -143,7 +152,7 @@ class ManualController:
             if ev.type == pg.KEYDOWN:
                 self.held.add(pg.key.name(ev.key))
                 if pg.key.name(ev.key) in self.keys.center:
-                    self.values[:3] = 0.0
+                    self.values[:3] = self.neutral
             elif ev.type == pg.KEYUP:
                 self.held.discard(pg.key.name(ev.key))
             elif ev.type == pg.MOUSEMOTION and self.device == "mouse":
@@ -181,8 +190,9 @@ class ManualController:
             for idx in range(3):
                 keyboard_axis = surfaces or (self.device == "mouse" and idx == 2)
                 if keyboard_axis and not moved[idx]:
-                    v = self.values[idx]
-                    self.values[idx] = 0.0 if abs(v) <= step else v - step * np.sign(v)
+                    off = self.values[idx] - self.neutral[idx]
+                    off = 0.0 if abs(off) <= step else off - step * np.sign(off)
+                    self.values[idx] = self.neutral[idx] + off
         np.clip(self.values, ACTION_LOW, ACTION_HIGH, out=self.values)
 
     def _mouse(self, pos: tuple[int, int]) -> None:
@@ -194,7 +204,8 @@ class ManualController:
             y = -y
         for idx, v in ((0, x), (1, y)):
             v = max(-1.0, min(1.0, v))
-            self.values[idx] = 0.0 if abs(v) < m.dead_zone else v
+            v = 0.0 if abs(v) < m.dead_zone else v
+            self.values[idx] = min(1.0, max(-1.0, self.neutral[idx] + v))
 
     def _joystick_event(self, pg: Any, ev: Any) -> list[str]:
         if ev.type == pg.JOYDEVICEADDED:
@@ -208,17 +219,20 @@ class ManualController:
         elif ev.type == pg.JOYDEVICEREMOVED:
             self.joysticks.pop(ev.instance_id, None)
             if not self.joysticks:
-                self.values[:3] = 0.0  # no stick, no deflection; throttle stays
+                self.values[:3] = self.neutral  # no stick, no deflection; throttle stays
                 self.status = "joystick unplugged: surfaces centred, plug it back in"
         elif ev.type == pg.JOYAXISMOTION:
             for control, axis in self.joy.axes.items():
                 if axis == ev.axis:
                     idx = ("aileron", "elevator", "rudder", "throttle").index(control)
-                    self.values[idx] = self.joy.shape(control, ev.value)
+                    value = self.joy.shape(control, ev.value)
+                    if idx < 3:  # a surface deflects from its neutral; the throttle is absolute
+                        value = min(1.0, max(-1.0, self.neutral[idx] + value))
+                    self.values[idx] = value
         elif ev.type == pg.JOYBUTTONDOWN:
             command = self.joy.buttons.get(ev.button)
             if command == "center":
-                self.values[:3] = 0.0
+                self.values[:3] = self.neutral
             elif command:
                 return [command]
         return []

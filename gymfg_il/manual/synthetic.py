@@ -155,6 +155,7 @@ class SyntheticPilot:
         self._lapse_left = 0.0
         self._last_obs: np.ndarray | None = None
         self._plugged = False
+        self.neutral: np.ndarray = np.zeros(3)  # the stick's neutral (start_from moves it)
         self.sent: list[Any] = []
         self.pressed: list[tuple[str, bool]] = []  # (key, down) this frame, for the record
 
@@ -179,9 +180,18 @@ class SyntheticPilot:
             return True
         return False
 
+    def start_from(self, action: np.ndarray) -> None:
+        """The aircraft's start controls (a trimmed start's trim): the intent starts from
+        them and the stick's neutral is there (``ManualController``)."""
+        self.neutral = np.array(action[:3], dtype=np.float64)
+        start = getattr(self.intent, "start_from", None)
+        if start is not None:
+            start(action)
+
     def events(self, observation: np.ndarray, stick: np.ndarray) -> list[Any]:
         """This frame's events, from the observation and the controls as they stand (also
-        kept as ``sent``; the keys among them as ``pressed``: (name, down))."""
+        kept as ``sent``; the keys among them as ``pressed``: (name, down)). The mouse and
+        the joystick aim at the wanted controls less the stick's neutral."""
         self.pressed = []
         seen = self._perceive(observation)
         want = np.clip(np.asarray(self.intent.act(seen), dtype=np.float64), ACTION_LOW, ACTION_HIGH)
@@ -230,7 +240,8 @@ class SyntheticPilot:
         out = []
         for control, axis in self.joy.axes.items():
             i = CONTROLS.index(control)
-            raw = self._raw(control, float(want[i]) + self.rng.normal(0.0, self.skill.tremor))
+            aim = float(want[i]) - (self.neutral[i] if i < 3 else 0.0)
+            raw = self._raw(control, aim + self.rng.normal(0.0, self.skill.tremor))
             raw = round(raw / self.skill.quantum) * self.skill.quantum
             raw = max(-1.0, min(1.0, raw))
             if self._axes.get(axis) != raw:
@@ -247,8 +258,8 @@ class SyntheticPilot:
     def _mouse(self, want: np.ndarray) -> list[Any]:
         m = self.mouse
         cx, cy = self.window_size[0] / 2, self.window_size[1] / 2
-        x = float(want[0]) + self.rng.normal(0.0, self.skill.tremor)
-        y = float(want[1]) + self.rng.normal(0.0, self.skill.tremor)
+        x = float(want[0] - self.neutral[0]) + self.rng.normal(0.0, self.skill.tremor)
+        y = float(want[1] - self.neutral[1]) + self.rng.normal(0.0, self.skill.tremor)
         if m.invert_elevator:
             y = -y
         pos = (round(cx + x * m.span_px), round(cy - y * m.span_px))
@@ -271,9 +282,7 @@ class PilotAgent:
 
     def start_from(self, action: np.ndarray) -> None:
         self.human.start_from(action)
-        start = getattr(self.pilot.intent, "start_from", None)
-        if start is not None:
-            start(action)
+        self.pilot.start_from(action)
 
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
         events = self.pilot.events(observation, self.human.values)

@@ -45,15 +45,20 @@ def test_keyboard_rates_and_centring_reach_the_dataset(tmp_path):
     frames = load_frames(tmp_path / "dataset")
     aileron, throttle = frames.action[:, 0], frames.action[:, 3]
     assert len(aileron) == 90
+    # the stick's neutral is the trimmed start's controls: frame 0 flies them
+    trim = aileron[0]
+    assert 0.01 < abs(trim) < 0.1  # the c172p trims with a little aileron
     # session frame k flies dataset frame k - 1 (Space at frame 1 starts and flies frame 0);
     # left held for session frames 3..12 at 1.5/s: -0.05 per frame
-    assert aileron[1] == 0.0 and aileron[2] == pytest.approx(-0.05)
-    assert aileron[11] == pytest.approx(-0.5, abs=1e-6)
-    # released: back to centre at 1/s (1/30 per frame) -> zero 15 frames later
-    assert aileron[12] == pytest.approx(-0.5 + 1 / 30, abs=1e-6)
-    assert aileron[30] == 0.0
-    # throttle up for 6 frames at 0.5/s from the c172p's cruise 0.75
-    assert throttle[45] == pytest.approx(0.75 + 6 * 0.5 / 30, abs=1e-6)
+    assert aileron[1] == trim and aileron[2] == pytest.approx(trim - 0.05)
+    assert aileron[11] == pytest.approx(trim - 0.5, abs=1e-6)
+    # released: back to the neutral at 1/s (1/30 per frame) -> there 15 frames later
+    assert aileron[12] == pytest.approx(trim - 0.5 + 1 / 30, abs=1e-6)
+    assert aileron[30] == trim
+    # throttle up for 6 frames at 0.5/s from the trim's throttle; released, it stays
+    assert throttle[38] == throttle[0]
+    assert throttle[45] == pytest.approx(throttle[0] + 6 * 0.5 / 30, abs=1e-6)
+    assert throttle[60] == throttle[45]
     assert not frames.episodes["gymfg/interventions"][0]
     assert frames.episodes["gymfg/source"] == ["human"]
 
@@ -65,9 +70,12 @@ def test_mouse_is_the_stick(tmp_path):
     script = {1: [lambda: key(pygame.K_SPACE)], 5: [move], 200: [lambda: key(pygame.K_q)]}
     run(tmp_path, script, device="mouse")
     frames = load_frames(tmp_path / "dataset")
-    # 100 px right of centre, 50 px up, span 200 px: aileron 0.5, elevator +0.25 (nose down)
-    assert frames.action[4, 0] == pytest.approx(0.5) and frames.action[4, 1] == pytest.approx(0.25)
-    assert frames.action[2, 0] == 0.0
+    # 100 px right of centre, 50 px up, span 200 px: aileron 0.5, elevator +0.25 (nose down),
+    # from the stick's neutral (the trim the episode starts with, flown at frame 0)
+    trim = frames.action[0]
+    assert frames.action[4, 0] == pytest.approx(trim[0] + 0.5)
+    assert frames.action[4, 1] == pytest.approx(trim[1] + 0.25)
+    assert frames.action[2, 0] == trim[0] and trim[1] > 0.1  # the c172p's trimmed elevator
 
 
 def test_joystick_axes_buttons_and_unplugging(tmp_path):
@@ -91,10 +99,11 @@ def test_joystick_axes_buttons_and_unplugging(tmp_path):
     frames = load_frames(tmp_path / "dataset")
     a = frames.action
     shaped = ((0.6 - 0.05) / 0.95) * 0.7 + 0.3 * ((0.6 - 0.05) / 0.95) ** 3
-    assert a[4, 0] == pytest.approx(shaped, rel=1e-6)
-    assert a[4, 1] == 0.0  # inside the dead zone
-    assert a[29, 0] == 0.0  # unplugged: centred, and the session went on
-    assert a[39, 0] == pytest.approx(shaped, rel=1e-6)  # plugged back in
+    trim = a[0]  # the stick deflects from its neutral, the trim flown at frame 0
+    assert a[4, 0] == pytest.approx(trim[0] + shaped, rel=1e-6)
+    assert a[4, 1] == trim[1]  # inside the dead zone
+    assert a[29, 0] == trim[0]  # unplugged: centred, and the session went on
+    assert a[39, 0] == pytest.approx(trim[0] + shaped, rel=1e-6)  # plugged back in
     assert len(a) == 59  # the button ended and saved the episode
 
 

@@ -37,7 +37,8 @@ def test_what_the_pilot_pressed_is_what_the_dataset_shows(tmp_path, device):
     assert len(frames) == 240 and frames.episodes["gymfg/source"] == ["synthetic"]
     # a fresh controller fed the pilot's own events gives the dataset's actions exactly
     ref = ManualController(device, throttle=0.75)
-    expected = [ref.values.copy()]  # the first step flies the reset controls
+    ref.start_from(frames.action[0].astype(np.float64))  # the trimmed start's controls
+    expected = [ref.values.copy()]  # the first step flies them
     for events in driver.sent:
         ref.handle(events, 1 / 30)
         expected.append(ref.values.copy())
