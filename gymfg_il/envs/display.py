@@ -15,7 +15,7 @@ from gymfg_il.viz.multiplayer import TrafficSender
 from gymfg_il.viz.netfdm import FlightGearSender
 
 if TYPE_CHECKING:
-    from gymfg_il.envs.world import Slot
+    from gymfg_il.envs.slots import Slot
 
 
 class Displays:

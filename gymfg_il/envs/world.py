@@ -12,113 +12,27 @@ import logging
 import math
 import time
 import zlib
-from collections import deque
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from gymfg_il.aircraft import Aircraft
 from gymfg_il.controllers.lead import LeadPilot
 from gymfg_il.envs.actions import Controls
 from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.display import Displays
+from gymfg_il.envs.slots import SimPool, Slot
 from gymfg_il.envs.team import Team, build_task, check_unique
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
-from gymfg_il.sim.properties import NAMES, ORIENTATION, POSITION, StateView, indices
-from gymfg_il.sim.simulation import Simulation
+from gymfg_il.sim.properties import ORIENTATION, POSITION, StateView, indices
 from gymfg_il.sim.timing import episode_steps
-from gymfg_il.tasks.base import Task
-from gymfg_il.tasks.rewards import RewardContext
 from gymfg_il.viz.multiplayer import CALLSIGN_BYTES
 from gymfg_il.viz.peers import MultiplayerLink, Peer
 
 log = logging.getLogger(__name__)
 
 __all__ = ["EnvConfig", "SimPool", "Slot", "World"]
-
-
-class SimPool:
-    """JSBSim instances kept across reconfigurations, so each is built once per model."""
-
-    def __init__(self, sim_hz: int, agent_hz: int) -> None:
-        self.sim_hz, self.agent_hz = sim_hz, agent_hz
-        self._free: dict[str, list[Simulation]] = {}
-
-    def take(self, model: str) -> Simulation:
-        free = self._free.get(model)
-        return free.pop() if free else Simulation(model, self.sim_hz, self.agent_hz)
-
-    def give_back(self, sims: Sequence[Simulation]) -> None:
-        for sim in sims:
-            self._free.setdefault(sim.model, []).append(sim)
-
-    def close(self) -> None:
-        for sims in self._free.values():
-            for sim in sims:
-                sim.close()
-        self._free.clear()
-
-
-class Slot:
-    """One aircraft's place in the world: its sim, task, last states, actions and reward."""
-
-    __slots__ = (
-        "action",
-        "aircraft",
-        "ctx",
-        "ended_at",
-        "history",
-        "index",
-        "prev_action",
-        "prev_state",
-        "reason",
-        "reward",
-        "sim",
-        "state",
-        "target_links",
-        "task",
-        "team",
-        "terminated",
-    )
-
-    def __init__(self, index: int, team: str, aircraft: Aircraft, task: Task, sim: Simulation):
-        self.index = index
-        self.team = team
-        self.aircraft = aircraft
-        self.task = task
-        self.sim = sim
-        self.state: np.ndarray = np.zeros(len(NAMES), dtype=np.float64)
-        self.prev_state: np.ndarray = self.state
-        self.action: np.ndarray = np.zeros(4)
-        self.prev_action: np.ndarray = self.action
-        self.reward = 0.0
-        self.terminated = False
-        self.reason: str | None = None
-        self.ended_at: int | None = None  # the step it terminated at
-        self.history: deque[tuple[np.ndarray, np.ndarray]] = deque(
-            maxlen=max(task.history_window, 1)
-        )
-        self.ctx = RewardContext(
-            StateView(self.state),
-            StateView(self.state),
-            self.action,
-            self.action,
-            history=self.history,
-        )
-        # (callsign, view to refresh, source slot or None (seen from a server), restricted to
-        # the opponent view?)
-        self.target_links: list[tuple[str, StateView, Slot | None, bool]] = []
-
-    def present(self, step: int) -> bool:
-        """Whether it is still there to be seen at ``step`` (it crashed at this step or
-        flies on; from the next step on, a terminated aircraft is absent)."""
-        return self.ended_at is None or self.ended_at >= step
-
-    @property
-    def callsign(self) -> str:
-        return self.aircraft.callsign
 
 
 class World:

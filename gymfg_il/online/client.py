@@ -11,8 +11,6 @@ others.
 from __future__ import annotations
 
 import logging
-import os
-import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -23,8 +21,8 @@ from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import SimPool, World
 from gymfg_il.errors import ConfigError, EnvStateError
-from gymfg_il.online.protocol import ProtocolError, ServerError, decode, encode
-from gymfg_il.online.threads import first_socket
+from gymfg_il.online.link import ServerLink
+from gymfg_il.online.protocol import ServerError
 from gymfg_il.sim.properties import ORIENTATION, POSITION
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 from gymfg_il.viz.peers import MultiplayerConfig
@@ -98,48 +96,19 @@ class OnlineEnv:
         batch_io: bool = True,
         multiplayer: MultiplayerConfig | None = None,
     ) -> None:
-        import zmq
-
-        if not (
-            isinstance(spin_us, int | float)
-            and not isinstance(spin_us, bool)
-            and 0 <= spin_us * 1e-6 < timeout_s
-        ):
-            raise ConfigError(
-                f"spin_us={spin_us!r}: give 0 (no polling) or a time in microseconds "
-                f"below timeout_s={timeout_s:g} s"
-            )
         self.address, self.token, self.timeout_s = address, token, timeout_s
-        self._spin_s = spin_us * 1e-6
-        self._wait_s = 0.0  # moving average of the wait for a reply
-        self._clock = time.perf_counter
         self.config = EnvConfig(
             sim_hz, agent_hz, views=views, traffic=traffic, multiplayer=multiplayer
         )
-        self._affinity: set[int] | None = None  # the calling thread's, while pinned
-        if cpu is not None:
-            available = os.sched_getaffinity(0)
-            if cpu not in available:
-                raise ConfigError(f"cpu={cpu!r}: this process may run on CPUs {sorted(available)}")
-            self._affinity = available
-            os.sched_setaffinity(0, {cpu})  # this thread, and the I/O thread started below
-        # the client's own context: its I/O thread starts pinned with it, and batched
-        self.ctx: Any = zmq.Context()
-        self._batch_io = batch_io
-        try:
-            self.sock = first_socket(self.ctx, zmq.DEALER, batch_io)
-            self.sock.setsockopt(zmq.LINGER, 0)
-            self.sock.setsockopt(zmq.RCVTIMEO, int(timeout_s * 1000))
-            if server_key is not None:
-                public, secret = zmq.curve_keypair()
-                self.sock.curve_publickey, self.sock.curve_secretkey = public, secret
-                self.sock.curve_serverkey = server_key
-            self.sock.connect(address)
-        except Exception:
-            if hasattr(self, "sock"):
-                self.sock.close(0)
-            self._release()
-            raise
+        self.link = ServerLink(
+            address,
+            token=token,
+            server_key=server_key,
+            timeout_s=timeout_s,
+            cpu=cpu,
+            spin_us=spin_us,
+            batch_io=batch_io,
+        )
         self._pool = SimPool(sim_hz, agent_hz)
         self.world: World | None = None
         self.team: Team | None = None
@@ -148,7 +117,6 @@ class OnlineEnv:
         self.joined = False
         self._rng = np.random.default_rng()
         self._done = True
-        self._waiting = ""  # the last reason the server gave for making the team wait
         self.opponents: list[str] = []
 
     @property
@@ -157,65 +125,8 @@ class OnlineEnv:
 
     # -- wire ----------------------------------------------------------------------------
     def _request(self, msg: dict[str, Any], expect: str) -> dict[str, Any]:
-        self._send(msg)
-        return self._receive(expect)
-
-    def _send(self, msg: dict[str, Any]) -> None:
-        self.sock.send(encode({**msg, "team": self.team.name, "token": self.token}))  # type: ignore[union-attr]
-
-    def _recv(self) -> bytes:
-        """The next message: polled for up to ``spin_us`` while replies have been coming
-        that fast, else slept on at once (RCVTIMEO bounds the sleep)."""
-        import zmq
-
-        clock = self._clock
-        start = clock()
-        if self._wait_s < self._spin_s:  # (typical waits: many teams sharing CPUs poll less)
-            recv, pause = self.sock.recv, os.sched_yield
-            deadline = start + self._spin_s
-            while True:
-                try:
-                    data = recv(zmq.NOBLOCK)
-                    break
-                except zmq.Again:
-                    if clock() > deadline:
-                        data = self.sock.recv()
-                        break
-                    pause()  # the I/O thread bringing the reply may need this CPU
-        else:
-            data = self.sock.recv()
-        # a moving average of the waits, each counted as at most twice the polling time, so
-        # one long wait (a join, a reset, a paused server) does not turn polling off
-        waited = min(clock() - start, 2 * self._spin_s)
-        self._wait_s += 0.1 * (waited - self._wait_s)
-        return data
-
-    def _receive(self, expect: str) -> dict[str, Any]:
-        import zmq
-
-        while True:
-            try:
-                data = self._recv()
-            except zmq.Again:
-                raise ServerError(
-                    "timeout",
-                    f"no answer from {self.address} within "
-                    f"{self.timeout_s:g} s; is the server running?",
-                ) from None
-            try:
-                reply = decode(data, "server")
-            except ProtocolError as err:
-                raise ServerError("malformed", f"the server sent a bad message: {err}") from None
-            if reply["type"] == "error":
-                raise ServerError(reply.get("code", "error"), reply.get("message", ""))
-            if reply["type"] == "wait":  # a paused or not yet started simulation
-                reason = str(reply.get("reason", ""))
-                if reason != self._waiting:  # said once per reason, not once per second
-                    log.warning("%s: %s", self.address, reason)
-                    self._waiting = reason
-                continue
-            if reply["type"] == expect:
-                return reply
+        assert self.team is not None
+        return self.link.request(msg, self.team.name, expect)
 
     def _join(self) -> dict[str, Any]:
         assert self.team is not None
@@ -330,12 +241,9 @@ class OnlineEnv:
             raise EnvStateError("call env.reset(team) before step (and again after the end)")
         world.step_physics(team_controls(team_actions, team.callsigns))
         terminated_now = all(s.terminated for s in world.slots)
-        self._send({"type": "report", "states": self._states(), "done": world.truncated})
-        if self._batch_io and self._wait_s < self._spin_s:
-            # the batched I/O thread, if it shares this CPU, sends it now; not when replies
-            # are slow to come (many teams sharing few CPUs): the yield then hands the CPU
-            # to another team and costs this one a context switch (16 teams on 2 cores: ~7%)
-            os.sched_yield()
+        link = self.link
+        link.send({"type": "report", "states": self._states(), "done": world.truncated}, team.name)
+        link.yield_after_send()
         # Rewards and observations need the other teams only when a reward targets them:
         # otherwise they are computed while the server gathers the other reports.
         early = not world.external
@@ -343,7 +251,7 @@ class OnlineEnv:
             if early:
                 observations, rewards, terminated, info = self._outcome()
         finally:  # even when scoring fails, this tick's reply must not be left unread
-            central = self._receive("central")
+            central = link.receive("central")
         opponents = self._opponents(central)
         if central["done"]:  # the simulation ended: its roster is gone, join the next anew
             self.joined = False
@@ -380,24 +288,15 @@ class OnlineEnv:
 
     def leave(self) -> None:
         if self.joined and self.team is not None:
-            self.sock.send(encode({"type": "leave", "team": self.team.name, "token": self.token}))
+            self.link.send({"type": "leave"}, self.team.name)
             self.joined = False
-
-    def _release(self) -> None:
-        """End the client's context and give a pinned thread its CPUs back."""
-        if not self.ctx.closed:
-            self.ctx.term()  # its socket is closed by now
-        if self._affinity is not None:
-            os.sched_setaffinity(0, self._affinity)
-            self._affinity = None
 
     def close(self) -> None:
         try:
             self.leave()
         finally:
             # a leave still queued gets a moment to go out, so the others need not time out
-            self.sock.close(linger=_LEAVE_LINGER_MS)
-            self._release()
+            self.link.close(_LEAVE_LINGER_MS)
             if self.world is not None:
                 self.world.close()
                 self.world = None

@@ -350,13 +350,13 @@ class SlowServer:
 def test_a_client_polls_while_replies_are_quick_and_sleeps_while_they_are_slow():
     env = OnlineEnv("tcp://127.0.0.1:1", spin_us=1000)
     fake = SlowServer()
-    env.sock.close(0)
-    env.sock, env._clock = fake, fake.clock
+    env.link.sock.close(0)
+    env.link.sock, env.link._clock = fake, fake.clock
 
     def waits(delay, n):
         fake.delay, fake.polls, fake.sleeps = delay, 0, 0
         for _ in range(n):
-            assert env._recv() == b"reply"
+            assert env.link.recv() == b"reply"
         return fake.polls, fake.sleeps
 
     polls, sleeps = waits(300e-6, 20)  # quick replies: caught by polling, never slept on
