@@ -102,7 +102,7 @@ def help_lines(device: str, kb: KeyboardBindings) -> list[str]:
     lines += [
         f"RUDDER   {keys(kb.rudder_left)}  |  {keys(kb.rudder_right)}",
         f"THROTTLE {keys(kb.throttle_up)}  |  {keys(kb.throttle_down)}",
-        f"CENTRE   {keys(kb.center)}  (surfaces return to centre at {kb.centering:g}/s)",
+        f"CENTRE   {keys(kb.center)}  (surfaces return to the trim at {kb.centering:g}/s)",
     ]
     return lines
 

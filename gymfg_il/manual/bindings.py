@@ -20,7 +20,7 @@ CONTROLS = ("aileron", "elevator", "rudder", "throttle")
 @dataclass
 class KeyboardBindings:
     """Keyboard flying: holding a key moves its control at ``rate`` per second; released
-    surfaces return to centre at ``centering`` per second (0 = they stay where they are).
+    surfaces return to their neutral (the trim) at ``centering`` per second (0 = they stay).
 
     Attributes:
         aileron_left, aileron_right, elevator_down, elevator_up, rudder_left, rudder_right,

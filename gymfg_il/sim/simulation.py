@@ -146,8 +146,31 @@ class Simulation:
         # fcs/*-trim-cmd-norm a label would depend on where the episode started)
         for set_trim in self._set_trims:
             set_trim(0.0)
+        if trim is not None:
+            self._settle_engines(trim.throttle)
         self.resets += 1
         return self.read()
+
+    def _settle_engines(self, throttle: float) -> None:
+        """Bring the engines to their steady state at the start's throttle.
+
+        JSBSim starts a running engine at its full-throttle steady state (``InitRunning`` also
+        sets the throttle commands to 1, which the first step overwrites), so from a trimmed
+        start the c172p's propeller spun down from ~2,780 to ~2,340 RPM over
+        the first second and pitched the aircraft at up to 0.021 rad/s. A run with the
+        integration suspended (as JSBSim's own ``RunIC`` does) loads the trim's throttle into
+        the engines without moving the clock or the aircraft; the steady state is then
+        computed from it. Hands-off pitch rates fall to <= 0.01 rad/s on the c172p.
+        """
+        fdm = self.fdm
+        for set_throttle in self._set_throttles:
+            set_throttle(throttle)
+        fdm.suspend_integration()
+        try:
+            self._run()
+            fdm.get_propulsion().get_steady_state()
+        finally:
+            fdm.resume_integration()
 
     def _retract_gear(self) -> None:
         """Fly once with the gear commanded up until it is stowed.

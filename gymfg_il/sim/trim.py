@@ -7,9 +7,9 @@ every reset: each aircraft model is trimmed on a grid (every 1,000 ft of altitud
 start between grid points interpolates its four corners. Results are cached per process;
 the trimming instance is reset from an initial-conditions file before every trim, so a grid
 point comes out the same whichever points were trimmed before it, in any process, and resets
-stay bit-reproducible. The trim's aileron and rudder go to JSBSim's roll and yaw trim, its
-elevator to the pitch trim, so an action of zeros (with the trim's throttle) is hands-off
-flight.
+stay bit-reproducible. A trimmed start puts the trim in the controls (``Simulation.reset``:
+its ``start_action``), never in JSBSim's trim commands, so an action is the whole command and
+the trim's controls with its throttle are hands-off flight.
 """
 
 from __future__ import annotations
@@ -34,9 +34,9 @@ class Trim:
 
     Attributes:
         pitch_deg: pitch angle (= angle of attack on a level path).
-        elevator: JSBSim ``fcs/pitch-trim-cmd-norm``.
-        aileron: JSBSim ``fcs/roll-trim-cmd-norm`` (the trim's aileron command).
-        rudder: JSBSim ``fcs/yaw-trim-cmd-norm`` (the trim's rudder command).
+        elevator: the elevator command that holds it (JSBSim's trim finds it as
+            ``fcs/pitch-trim-cmd-norm``).
+        aileron, rudder: the aileron and rudder commands that hold it.
         throttle: throttle command of every engine.
     """
 

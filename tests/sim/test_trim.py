@@ -43,9 +43,11 @@ def test_hands_off_flight_from_a_reset_holds_altitude_and_pitch(model):
         sim.reset(ic, profile.cruise_throttle)
         worst_h, worst_q = _hands_off(sim)
         assert worst_h < 50.0, (model, ic, worst_h)
-        # the c172p's propeller spins down from the full-throttle RPM JSBSim starts a
-        # running engine at: 0.019-0.020 rad/s in the first 0.3 s, 0.005 after
-        assert worst_q < (0.021 if model == "c172p" else 0.02), (model, ic, worst_q)
+        # the engines start in their steady state at the trim's throttle (JSBSim starts
+        # them at full throttle's: the c172p then pitched at 0.019-0.021 rad/s)
+        assert worst_q < 0.02, (model, ic, worst_q)
+        assert worst_h < (5.0 if model == "c172p" else 2.0), (model, ic, worst_h)
+        assert worst_q < (0.011 if model == "c172p" else 0.003), (model, ic, worst_q)
 
 
 def test_untrimmed_starts_remain_and_show_the_transient():
