@@ -2,10 +2,13 @@
 
 Per step and aircraft the writer adds a ``foxglove.FrameTransform`` and fills
 ``foxglove.LocationFix.heading`` and ``velocity``; per episode and aircraft a
-``foxglove.SceneUpdate`` draws the aircraft in its own frame (so the transforms move it) and
-the task's target, redrawn while a dynamic target moves (``Aim``). Foxglove matches these schemas by
-name and field layout: ``foxglove_schemas/`` holds them exactly as ``@foxglove/schemas``
-1.13.0 publishes them (MIT licence, Foxglove Technologies; see its README).
+``foxglove.SceneUpdate`` draws the aircraft in its own frame (so the transforms move it), the
+task's target, redrawn while a dynamic target moves (``Aim``), and what the task places in
+the world (``tasks.scenery``: the approach's runway, the waypoint gates; a formation's lead
+gets a frame of its own, ``<callsign>/lead``, moved by a transform every step). Foxglove
+matches these schemas by name and field layout: ``foxglove_schemas/`` holds them exactly as
+``@foxglove/schemas`` 1.13.0 publishes them (MIT licence, Foxglove Technologies; see its
+README).
 
 Frames and conventions:
 
@@ -34,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.sim.properties import INDEX
+from gymfg_il.tasks.scenery import Landmark
 
 SCHEMAS = Path(__file__).with_name("foxglove_schemas")
 PARENT_FRAME = "enu"
@@ -49,6 +53,8 @@ _TARGET_COLOUR = {"r": 0.1, "g": 0.9, "b": 0.4, "a": 0.25}
 _PLANE_M = 4000.0  # side of the target-altitude plane
 _LINE_M = 3000.0  # length of the target-heading line
 _UNITS = {"ft": "ft", "deg": "deg", "kt": "kt"}
+_RUNWAY_COLOUR = {"r": 0.3, "g": 0.3, "b": 0.32, "a": 1.0}
+_GATE_COLOUR = {"r": 0.92, "g": 0.43, "b": 0.08, "a": 1.0}
 _ROLL, _PITCH, _HEADING = INDEX["roll_deg"], INDEX["pitch_deg"], INDEX["heading_deg"]
 _U, _V, _W = INDEX["u_fps"], INDEX["v_fps"], INDEX["w_fps"]
 
@@ -135,6 +141,65 @@ def transform(
         "rotation": rotation,
     }
     return message, where, velocity
+
+
+def pose_transform(frame: LocalFrame, ns: int, child: str, mark: Landmark) -> dict[str, Any]:
+    """The FrameTransform ``enu`` -> ``child`` placing a landmark (a formation's lead)."""
+    x, y, z = frame.enu(mark.lat_deg, mark.lon_deg, mark.alt_ft * FT_TO_M)
+    rotation, _ = attitude(mark.roll_deg, mark.pitch_deg, mark.heading_deg, (0.0, 0.0, 0.0))
+    return {
+        "timestamp": stamp(ns),
+        "parent_frame_id": PARENT_FRAME,
+        "child_frame_id": child,
+        "translation": {"x": x, "y": y, "z": z},
+        "rotation": rotation,
+    }
+
+
+def scenery_entities(
+    ns: int, callsign: str, marks: Sequence[Landmark], frame: LocalFrame
+) -> list[dict[str, Any]]:
+    """What ``callsign``'s task places in the world, in ``enu``: a runway as a flat slab from
+    its threshold along its course, a gate as a loop around what counts as inside it, an
+    aircraft (a formation's lead) in its own frame ``<callsign>/lead``."""
+    cubes, lines, out = [], [], []
+    for mark in marks:
+        x, y, z = frame.enu(mark.lat_deg, mark.lon_deg, mark.alt_ft * FT_TO_M)
+        psi = math.radians(mark.heading_deg)
+        ahead, right = (math.sin(psi), math.cos(psi)), (math.cos(psi), -math.sin(psi))
+        if mark.kind == "runway":
+            half = mark.length_ft * FT_TO_M / 2
+            yaw = (math.pi / 2 - psi) / 2
+            pose = {
+                "position": {"x": x + ahead[0] * half, "y": y + ahead[1] * half, "z": z},
+                "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(yaw), "w": math.cos(yaw)},
+            }
+            size = {"x": 2 * half, "y": mark.width_ft * FT_TO_M, "z": 0.5}
+            cubes.append({"pose": pose, "size": size, "color": _RUNWAY_COLOUR})
+        elif mark.kind == "gate":
+            w, h = mark.width_ft * FT_TO_M / 2, mark.length_ft * FT_TO_M / 2
+            corners = [
+                {"x": x + right[0] * a * w, "y": y + right[1] * a * w, "z": z + b * h}
+                for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))
+            ]
+            lines.append(
+                {
+                    "type": 1,  # a loop
+                    "pose": _pose(),
+                    "thickness": 4.0,
+                    "scale_invariant": True,
+                    "points": corners,
+                    "color": _GATE_COLOUR,
+                    "colors": [],
+                    "indices": [],
+                }
+            )
+        elif mark.kind == "aircraft":
+            lead = aircraft_entity(ns, f"{callsign}/lead", "", 1)
+            out.append({**lead, "texts": [_text(f"{callsign}'s lead", 8.0)]})
+    if cubes or lines:
+        out.append(_entity(ns, PARENT_FRAME, f"{callsign}/scenery", cubes=cubes, lines=lines))
+    return out
 
 
 def stamp(ns: int) -> dict[str, int]:

@@ -28,6 +28,7 @@ from gymfg_il.recording import schemas
 from gymfg_il.recording.session import SESSION_METADATA
 from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
 from gymfg_il.sim.properties import ACTION_NAMES, INDEX, NAMES
+from gymfg_il.tasks.scenery import task_landmarks
 
 EPISODE_TOPIC = "/gymfg/episode"
 _FT_TO_M = fg.FT_TO_M
@@ -139,6 +140,7 @@ class TrajectoryWriter:
         }
         self._frame = fg.LocalFrame(0.0, 0.0, 0.0)
         self._aims: dict[str, fg.Aim] = {}
+        self._leads: dict[str, tuple[str, dict[str, Any]]] = {}  # callsign -> (task, plan)
         self._views = (
             {t: w.register_channel(view_topic(t), "json", view) for t in teams}
             if len(teams) > 1 or session.get("online")
@@ -202,7 +204,7 @@ class TrajectoryWriter:
             return
         lat, lon, alt_ft = starts[0].state[:3].tolist()
         self._frame = fg.LocalFrame(lat, lon, alt_ft * _FT_TO_M)
-        self._aims = {}
+        self._aims, self._leads = {}, {}
         for s in starts:
             if s.callsign not in self._scenes:
                 continue
@@ -215,10 +217,23 @@ class TrajectoryWriter:
                 self._clock_ns, s.callsign, s.task, aim.value if aim else s.target, where,
                 self._frame,
             )  # fmt: skip
+            marks = task_landmarks(s.task.get("task", ""), s.task.get("plan"), 0)
+            entities += fg.scenery_entities(self._clock_ns, s.callsign, marks, self._frame)
             deletion = {"timestamp": fg.stamp(self._clock_ns), "type": 1, "id": ""}
             self._emit(self._scenes[s.callsign], {"deletions": [deletion], "entities": entities})
             if aim is not None and aim.dynamic:
                 self._aims[s.callsign] = aim
+            if any(m.kind == "aircraft" for m in marks):
+                self._leads[s.callsign] = (s.task["task"], s.task["plan"])
+                self._place_lead(s.callsign, 0)
+
+    def _place_lead(self, callsign: str, step: int) -> None:
+        """Move ``callsign``'s lead (a formation's) to where its track has it at ``step``."""
+        task, plan = self._leads[callsign]
+        for mark in task_landmarks(task, plan, step):
+            if mark.kind == "aircraft":
+                lead = fg.pose_transform(self._frame, self._clock_ns, f"{callsign}/lead", mark)
+                self._emit(self._tfs[callsign], lead)
 
     def _transform(
         self, callsign: str, values: list[float]
@@ -315,6 +330,8 @@ class TrajectoryWriter:
                 "velocity": velocity,
             },
         )
+        if callsign in self._leads:
+            self._place_lead(callsign, step)
         aim = self._aims.get(callsign)
         if aim is not None and aim.moved(observation):
             entities = fg.target_entities(

@@ -227,3 +227,60 @@ def test_shipped_layout_shows_what_an_altitude_log_holds(altitude_log):
     assert "altitude_ft" in state and "elevator" in step["action"]
     used = {layout["layout"]["first"], *json.dumps(layout["layout"]).split('"')}
     assert set(panels) <= used
+
+
+@pytest.mark.parametrize("task", ["waypoints", "approach", "formation"])
+def test_scene_draws_what_a_maneuver_places(task, tmp_path):
+    """Gates, the runway and a formation's lead are in the 3D view where the task's own
+    landmarks (what the camera draws) put them; the lead moves with its track."""
+    from gymfg_il.tasks.scenery import task_landmarks
+
+    cfg = CollectConfig(task=task, episodes=1, episode_time_s=3, out=tmp_path)
+    path = record_autopilot(cfg).log
+    msgs, _ = messages(path)
+    log = read_log(path)
+    start = log.complete_episodes[0].start_of("ego")
+    plan = start["plan"]
+    s0 = start["initial_state"]
+    frame = foxglove.LocalFrame(s0["lat_deg"], s0["lon_deg"], s0["altitude_ft"] * 0.3048)
+    marks = task_landmarks(task, plan, 0)
+    (scene,) = msgs["/gymfg/ego/scene"]
+    entities = {e["id"]: e for e in scene["entities"]}
+    validator = jsonschema.Draft7Validator(foxglove.schema("foxglove.SceneUpdate"))
+    validator.validate(scene)
+    if task == "waypoints":
+        loops = entities["ego/scenery"]["lines"]
+        assert len(loops) == len(marks) == 3 and entities["ego/scenery"]["frame_id"] == "enu"
+        for loop, mark in zip(loops, marks, strict=True):
+            centre = np.mean([[p[k] for k in "xyz"] for p in loop["points"]], axis=0)
+            want = frame.enu(mark.lat_deg, mark.lon_deg, mark.alt_ft * 0.3048)
+            assert np.allclose(centre, want, atol=1e-6)
+            side = np.subtract(*[[loop["points"][i][k] for k in "xyz"] for i in (1, 0)])
+            assert np.linalg.norm(side) == pytest.approx(mark.width_ft * 0.3048)
+            facing = (
+                math.sin(math.radians(mark.heading_deg)),
+                math.cos(math.radians(mark.heading_deg)),
+            )
+            assert abs(np.dot(side[:2], facing)) < 1e-6  # across the leg that leads to it
+    elif task == "approach":
+        (slab,) = entities["ego/scenery"]["cubes"]
+        (mark,) = marks
+        threshold = np.array(frame.enu(mark.lat_deg, mark.lon_deg, mark.alt_ft * 0.3048))
+        centre = np.array([slab["pose"]["position"][k] for k in "xyz"])
+        along = rotate(slab["pose"]["orientation"], [1, 0, 0])  # the slab's length axis
+        course = np.radians(mark.heading_deg)
+        assert np.allclose(along, [math.sin(course), math.cos(course), 0], atol=1e-9)
+        half = mark.length_ft * 0.3048 / 2
+        assert np.allclose(centre, threshold + along * half, atol=1e-6)
+        assert slab["size"]["y"] == pytest.approx(mark.width_ft * 0.3048)
+    else:
+        assert entities["ego/lead"]["frame_id"] == "ego/lead"
+        leads = [m for m in msgs["/gymfg/ego/tf"] if m["child_frame_id"] == "ego/lead"]
+        steps = len(log.complete_episodes[0].steps["ego"])
+        assert len(leads) == steps + 1  # at the reset and after every step
+        for k in (0, steps):
+            (mark,) = task_landmarks(task, plan, k)
+            want = frame.enu(mark.lat_deg, mark.lon_deg, mark.alt_ft * 0.3048)
+            assert np.allclose([leads[k]["translation"][c] for c in "xyz"], want, atol=1e-6)
+        moved = np.subtract(*[[leads[i]["translation"][c] for c in "xy"] for i in (steps, 0)])
+        assert np.linalg.norm(moved) > 100  # 3 s of the lead's flight
