@@ -113,6 +113,10 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
         ("DART noise (action std)", _counted(episodes.get("gymfg/noise", []))
          if episodes else "unknown"),
         ("weather", "; ".join(weather) or "unknown"),
+        ("starts", ", ".join(sorted(
+            {"trimmed straight, level flight" if s.trimmed_starts else "untrimmed"
+             for s in specs}
+        )) or "unknown"),
         ("rates", f"{meta.fps} fps (agent steps); JSBSim at "
          f"{', '.join(str(h) for h in sim_hz) or 'unknown'} Hz"),
         ("episodes", f"{meta.total_episodes} ({meta.total_frames} frames)"),

@@ -51,6 +51,7 @@ def test_a_collected_dataset_has_a_card_naming_what_it_holds(static):
     assert "| rates | 10 fps (agent steps); JSBSim at 120 Hz |" in body
     assert "| episodes | 2 (80 frames) |" in body
     assert "| cameras | none |" in body
+    assert "| starts | trimmed straight, level flight |" in body
     assert "autopilot (2 episodes)" in body and "turbulence light" in body
     assert "| DART noise (action std) | 0.02 (2 episodes) |" in body
     names = log.aircraft("ego")["observation_names"]
