@@ -8,6 +8,14 @@ multiplayer traffic, so the simulation's other aircraft appear in it (``viz.mult
 Debian/Ubuntu: ``apt-get install flightgear`` (it lands
 in /usr/games); under Xvfb it needs ``dbus-run-session`` in front, which the launcher adds when
 it is there.
+
+What of ``flightgear-python`` (a dependency, for the cockpit's FGNetCtrls struct) is not used
+here, and why: the native-fdm stream is JSBSim's own (its ``FLIGHTGEAR`` output directive
+writes net_fdm, so no codec of ours or theirs is involved); its ``TelnetConnection`` connects
+once, at construction, and parses prompts, while this launcher's property client asks in
+FlightGear's ``data`` mode (one line a reply) and connects again after a failure, since
+fgfs accepts connections seconds before it answers them; and it has no multiplayer protocol
+(``viz.multiplayer`` is ours).
 """
 
 from __future__ import annotations
