@@ -92,13 +92,20 @@ def create_metadata(
 
 
 def video_encoder() -> Any:
-    """LeRobot's encoder settings for camera features: H.264 (yuv420p, crf 23) with a key
-    frame every 2 frames (LeRobot's default, for random access) and the fastest preset
-    (``datasets.videos`` gives the figures)."""
+    """LeRobot's encoder settings for camera features: lossless H.264 (crf 0, full colour:
+    yuv444p) with a key frame every 2 frames (LeRobot's default, for random access) and the
+    fastest preset (``datasets.videos`` gives the figures).
+
+    Lossless because a vision policy flies by the camera's own frames: trained on frames
+    that went through lossy H.264 (crf 23, yuv420p: 2.0 levels off on average, up to 32), its
+    roll estimate on the camera's frames was off by 0.59 deg RMS against 0.23 on decoded ones,
+    with heading-dependent biases up to 1.2 deg. Lossless frames are within one level of the
+    drawn ones (the colour conversion), encode as fast, and take ~7.6 KiB a 128x128 frame
+    against ~2.5 (measured here)."""
     check_version()
     from lerobot.configs.video import RGBEncoderConfig
 
-    return RGBEncoderConfig(vcodec="h264", pix_fmt="yuv420p", g=2, crf=23, preset="ultrafast")
+    return RGBEncoderConfig(vcodec="h264", pix_fmt="yuv444p", g=2, crf=0, preset="ultrafast")
 
 
 def image_stats(frames: Any) -> dict[str, Any]:

@@ -41,11 +41,11 @@ def test_stock_lerobot_decodes_the_frames_the_camera_draws(camera_dataset):
         image = item["observation.images.front"]
         assert tuple(image.shape) == (3, 128, 128)
         decoded = image.numpy().transpose(1, 2, 0) * 255.0
-        # H.264 at crf 23 keeps each frame within a few levels of what was drawn, and the
-        # drawn frame nearest to it is its own (or a neighbour 0.1 s away)
+        # lossless H.264 (crf 0, yuv444p) gives back what was drawn within one level (the
+        # colour conversion), and the drawn frame nearest to it is its own
         diffs = [np.abs(decoded - d).mean() for d in drawn]
-        assert diffs[k] < 4.0
-        assert abs(int(np.argmin(diffs)) - k) <= 1
+        assert diffs[k] < 0.6 and np.abs(decoded - drawn[k]).max() <= 1.01
+        assert int(np.argmin(diffs)) == k
         assert np.allclose(
             item["observation.state"].numpy(), log.complete_episodes[1].steps["ego"].observation[k]
         )
