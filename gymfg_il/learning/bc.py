@@ -209,7 +209,8 @@ def _train(
     import torch
 
     from gymfg_il.learning.data import TensorBatches, check_tasks, load_frames, split_by_episode
-    from gymfg_il.policies.factory import make_config, make_policy, save_policy
+    from gymfg_il.policies.configuration_vision import VisionConfig
+    from gymfg_il.policies.factory import PolicyConfig, make_config, make_policy, save_policy
 
     device = resolve_device(cfg.device)
     camera = cfg.camera if cfg.policy == "vision" else None
@@ -244,30 +245,18 @@ def _train(
     chunks: tuple[int, int] | None = None
     stack: int | None = None
     pool = 1
+    pconf: PolicyConfig
     if cfg.policy == "vision":
-        names = frames.observation_names
-        targets = [n for n in names if n.endswith("_target")]
-        shown = [n for n in names if n not in targets and not n.endswith("_integral")]
-        # no error integrals: summing its own estimate in flight drifted (roll: 52-56 % of
-        # the controller's return against 77-82 % without; see VisionConfig)
-        memory: list[str] = []
         assert frames.images is not None
-        pconf = make_config(
-            "vision",
+        pconf = VisionConfig.for_observation(
+            list(frames.observation_names),
             camera=cfg.camera,
             image_size=int(frames.images.shape[1]),
             frames=cfg.frames,
             hidden=list(cfg.hidden),
-            state_names=targets,
-            state_index=[names.index(n) for n in targets],
-            aux_names=shown,
-            aux_index=[names.index(n) for n in shown],
-            memory_names=memory,
-            memory_index=[names.index(n) for n in memory],
-            memory_source=[shown.index(n.removesuffix("_integral")) for n in memory],
             dt=1.0 / frames.fps,
         )
-        stack, pool = cfg.frames, pconf.pool  # type: ignore[union-attr]
+        stack, pool = cfg.frames, pconf.pool
     elif cfg.policy == "gru":
         pconf = make_config("gru", hidden=cfg.hidden[0], sequence_length=cfg.sequence_length)
         sequence = cfg.sequence_length

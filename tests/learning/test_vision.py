@@ -1,5 +1,6 @@
-"""The vision policy: a CNN over the camera plus the task's targets, trained on a camera
-dataset and flown with the env's camera."""
+"""The vision policy: an eye (a CNN over the camera) and hands (an MLP over what the eye
+estimates and the task's targets), trained on a camera dataset and flown with the env's
+camera."""
 
 import numpy as np
 import pytest
@@ -13,7 +14,7 @@ from gymfg_il.learning.bc import TrainConfig, train_bc
 from gymfg_il.learning.data import TensorBatches, load_frames
 from gymfg_il.policies.agent import PolicyAgent
 from gymfg_il.policies.configuration_vision import VisionConfig
-from gymfg_il.policies.modeling_vision import pool_frames
+from gymfg_il.policies.modeling_vision import VisionPolicy, pool_frames
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.loop import Rollout
 
@@ -51,8 +52,14 @@ def test_a_vision_policy_trains_and_flies_by_the_envs_camera(roll_images, tmp_pa
     policy_cfg = result.meta["train"]
     assert policy_cfg["policy"] == "vision"
     agent = PolicyAgent.load(tmp_path)
-    assert agent.policy.config.state_names == ["roll_deg_target"]
-    assert agent.policy.config.memory_names == []
+    config = agent.policy.config
+    assert config.target_names == ["roll_deg_target"]
+    assert config.error_names == ["roll_deg_error"]
+    assert config.integral_names == ["roll_deg_error_integral"]
+    assert "roll_deg" in config.seen_names and "altitude_ft" in config.seen_names
+    assert not any(n.endswith(("_target", "_error", "_integral")) for n in config.seen_names)
+    # the hands learned with the eye's running error added to what it estimates
+    assert (agent.policy.eye_error > 0).all()
     with pytest.raises(ConfigError, match="camera"):
         agent.act(np.zeros(13, np.float32))  # outside an env it has no eyes
     from gymfg_il.envs.single import AircraftEnv
@@ -72,3 +79,28 @@ def test_pooling_is_the_block_mean_and_the_config_checks_its_sizes():
         VisionConfig(image_size=32, pool=4, channels=[8, 8, 8, 8])
     with pytest.raises(ConfigError, match="camera"):
         VisionConfig(camera="cockpit")
+
+
+def test_in_flight_errors_and_integrals_come_from_the_eyes_estimates():
+    names = ["roll_deg", "heading_deg", "roll_deg_target", "roll_deg_error",
+             "roll_deg_error_integral", "heading_deg_target", "heading_deg_error"]  # fmt: skip
+    cfg = VisionConfig.for_observation(
+        names, image_size=16, pool=1, channels=[4], hidden=[8], dt=0.1
+    )
+    assert cfg.seen_names == ["roll_deg", "heading_deg"] and cfg.angular == [False, True]
+    unit = {"mean": np.zeros(len(names)), "std": np.ones(len(names))}
+    policy = VisionPolicy(cfg, unit, {"mean": np.zeros(4), "std": np.ones(4)})
+    policy.look = lambda images: torch.tensor([[10.0, 350.0]])  # the eye reads these
+    flown = []
+    policy.fly = lambda obs: (flown.append(obs.clone()), torch.zeros(1, 4))[1]
+    # the observation's own state, errors and integral are truth the policy must not read
+    obs = torch.tensor([[0.0, 0.0, 12.5, 99.0, 99.0, 5.0, 99.0]])
+    frame = torch.zeros(1, 16, 16, 3, dtype=torch.uint8)
+    _, state = policy.act((frame, obs))
+    _, state = policy.act((frame, obs), state)
+    seen = flown[-1][0]
+    assert seen[0] == 10.0 and seen[1] == 350.0  # the estimates
+    assert seen[3] == pytest.approx(2.5)  # roll error: target 12.5 less the estimate 10
+    assert seen[6] == pytest.approx(15.0)  # heading error wraps: 5 - 350 is +15
+    assert seen[4] == pytest.approx(2 * 2.5 * 0.1)  # two steps of the error, times dt
+    assert seen[2] == 12.5 and seen[5] == 5.0  # targets are read as they are
