@@ -1,5 +1,5 @@
-"""The vision policy: an eye (a CNN over stacked camera frames that estimates what a pilot
-reads out of the window) and hands (an MLP that flies from those estimates and the task's
+"""The vision policy: an eye (a CNN over stacked camera frames that estimates the aircraft's
+state the task observes) and hands (an MLP that flies from those estimates and the task's
 targets). Trained together by behaviour cloning; in flight the agent hands it the env's
 camera frame beside the observation (``policies.agent``), of which it reads only the targets.
 """
@@ -54,9 +54,8 @@ class VisionPolicy(NormalizedPolicy):
             nn.GELU(),
             nn.Linear(256, n_seen),
         )
-        for name in ("seen_index", "target_index", "error_index", "error_seen", "error_target"):
-            self.register_buffer(name, torch.as_tensor(getattr(config, name), dtype=torch.long))
-        for name in ("integral_index", "integral_error"):
+        for name in ("seen_index", "target_index", "error_index", "error_seen", "error_target",
+                     "integral_index", "integral_error"):  # fmt: skip
             self.register_buffer(name, torch.as_tensor(getattr(config, name), dtype=torch.long))
         self.register_buffer("angular", torch.as_tensor(config.angular, dtype=torch.bool))
         hands = [*config.seen_index, *config.target_index, *config.error_index]
