@@ -256,14 +256,17 @@ class World:
         ctx.target = task.target_value(self.steps)
         if slot.target_links:
             self._show_targets(slot)
-        reward = task.reward(ctx)
-        if not math.isfinite(reward):
-            raise ConfigError(
-                f"the reward of {slot.callsign!r} ({type(task).__name__}) returned {reward!r}; "
-                "rewards must be finite"
-            )
-        slot.reward = reward
         reason = task.termination(slot.state)
+        if reason == "diverged":  # no flight to score: the step earns nothing
+            reward = 0.0
+        else:
+            reward = task.reward(ctx)
+            if not math.isfinite(reward):
+                raise ConfigError(
+                    f"the reward of {slot.callsign!r} ({type(task).__name__}) returned "
+                    f"{reward!r}; rewards must be finite"
+                )
+        slot.reward = reward
         if reason is not None:
             slot.terminated = True
             slot.reason = reason

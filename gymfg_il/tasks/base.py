@@ -8,6 +8,7 @@ reward without a subclass is one lambda: ``DummyTask(reward=lambda ctx: ...)``.
 from __future__ import annotations
 
 import inspect
+import math
 from typing import Any, ClassVar
 
 import numpy as np
@@ -35,6 +36,12 @@ FLIGHT_VARS: tuple[str, ...] = (
 _AGL = INDEX["altitude_agl_ft"]
 _ALT = INDEX["altitude_ft"]
 _VC = INDEX["airspeed_kts"]
+_P, _Q, _R, _NZ = (INDEX[n] for n in ("p_rad_s", "q_rad_s", "r_rad_s", "load_factor_g"))
+# beyond these JSBSim has diverged, not flown: no aircraft turns at 20 rad/s or pulls 30 g
+# (an A320 that struck the ground between two agent steps came back at 3e17 rad/s and 1e35 g,
+# then NaN)
+MAX_RATE_RAD_S = 20.0
+MAX_LOAD_G = 30.0
 
 
 class Task:
@@ -157,9 +164,19 @@ class Task:
         return None
 
     def termination(self, state: np.ndarray) -> str | None:
-        """Why the aircraft must stop now (crashed, stalled, ...), or None to go on."""
+        """Why the aircraft must stop now (crashed, stalled, ...), or None to go on;
+        ``diverged`` when the state is not a flight (NaN, or rates and loads no aircraft
+        reaches: JSBSim blew up, typically on a ground strike between two agent steps)."""
         agl = state[_AGL]
-        if agl != agl or state[_VC] != state[_VC]:
+        # written so that NaN fails every comparison
+        if not (
+            abs(agl) < math.inf
+            and abs(state[_VC]) < math.inf
+            and abs(state[_NZ]) < MAX_LOAD_G
+            and abs(state[_P]) < MAX_RATE_RAD_S
+            and abs(state[_Q]) < MAX_RATE_RAD_S
+            and abs(state[_R]) < MAX_RATE_RAD_S
+        ):
             return "diverged"
         if agl < self._min_agl:
             return "crashed"

@@ -123,6 +123,33 @@ def test_envelope_termination():
     assert task.termination(state(airspeed_kts=20)) == "stalled"
     assert task.termination(state(altitude_ft=99999)) == "above_ceiling"
     assert task.termination(state(airspeed_kts=float("nan"))) == "diverged"
+    # JSBSim blown up by a ground strike between two steps: finite, but no flight
+    assert task.termination(state(p_rad_s=-3.3e17, load_factor_g=-1.25e35)) == "diverged"
+    assert task.termination(state(load_factor_g=45.0)) == "diverged"
+    assert task.termination(state(q_rad_s=float("inf"))) == "diverged"
+    assert task.termination(state(p_rad_s=4.0, load_factor_g=9.0)) is None  # an F-15 can
+
+
+def test_a_diverged_simulation_ends_the_episode_instead_of_failing_it():
+    """An aircraft whose JSBSim state went NaN is terminated as diverged, with reward 0, and
+    the episode's record holds it (eval and collection go on to the next episode)."""
+    from gymfg_il.envs.single import AircraftEnv
+
+    env = AircraftEnv("heading", "A320", episode_time_s=5)
+    env.reset(seed=0)
+    slot = env.world.slots[0]
+    env.step(np.array([0.0, 0.0, 0.0, 0.5]))
+    read = slot.sim.read
+
+    def blown_up():  # what JSBSim gave after an A320 struck the ground between two steps
+        values = read()
+        values[INDEX["p_rad_s"]], values[INDEX["altitude_agl_ft"]] = -3.3e17, float("nan")
+        return values
+
+    slot.sim.read = blown_up
+    obs, reward, terminated, truncated, info = env.step(np.array([0.0, 0.0, 0.0, 0.5]))
+    assert terminated and not truncated and reward == 0.0
+    assert slot.reason == "diverged"
 
 
 def test_geometry_and_orientation():
