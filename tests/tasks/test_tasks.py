@@ -147,7 +147,7 @@ def test_a_diverged_simulation_ends_the_episode_instead_of_failing_it():
         return values
 
     slot.sim.read = blown_up
-    obs, reward, terminated, truncated, info = env.step(np.array([0.0, 0.0, 0.0, 0.5]))
+    _, reward, terminated, truncated, _ = env.step(np.array([0.0, 0.0, 0.0, 0.5]))
     assert terminated and not truncated and reward == 0.0
     assert slot.reason == "diverged"
 
