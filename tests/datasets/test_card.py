@@ -53,7 +53,7 @@ def test_a_collected_dataset_has_a_card_naming_what_it_holds(static):
     assert "| cameras | none |" in body
     assert "| starts | trimmed straight, level flight |" in body
     assert "autopilot (2 episodes)" in body and "turbulence light" in body
-    assert "| DART noise (action std) | 0.02 (2 episodes) |" in body
+    assert "| DART noise (action std) | 0.05 (2 episodes) |" in body  # the default
     names = log.aircraft("ego")["observation_names"]
     for i, name in enumerate(names):
         assert f"| {i} | {name} | {unit_of(name)} |" in body

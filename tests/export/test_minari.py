@@ -99,7 +99,7 @@ def test_the_cli_exports_a_clean_dataset_folder_without_its_logs(tmp_path, capsy
 def test_what_cannot_be_exported_says_why(noisy, tmp_path):
     alone = tmp_path / "alone"
     shutil.copytree(noisy / "dataset", alone)
-    with pytest.raises(ConfigError, match=r"flown with noise 0\.02: its flown actions are only"):
+    with pytest.raises(ConfigError, match=r"flown with noise 0\.05: its flown actions are only"):
         export_dataset(alone, NAME, tmp_path / "m")
     assert not (tmp_path / "m" / "gymfg" / "roll-c172p-v0").exists()
     with pytest.raises(ConfigError, match="no LeRobot dataset at"):
