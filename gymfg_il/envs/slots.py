@@ -45,6 +45,7 @@ class Slot:
     __slots__ = (
         "action",
         "aircraft",
+        "blown",
         "ctx",
         "ended_at",
         "history",
@@ -75,6 +76,7 @@ class Slot:
         self.terminated = False
         self.reason: str | None = None
         self.ended_at: int | None = None  # the step it terminated at
+        self.blown = False  # its simulation diverged (``World.step_physics``)
         self.history: deque[tuple[np.ndarray, np.ndarray]] = deque(
             maxlen=max(task.history_window, 1)
         )

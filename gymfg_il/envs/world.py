@@ -27,6 +27,7 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import ORIENTATION, POSITION, StateView, indices
 from gymfg_il.sim.timing import episode_steps
+from gymfg_il.tasks.base import diverged
 from gymfg_il.viz.multiplayer import CALLSIGN_BYTES
 from gymfg_il.viz.peers import MultiplayerLink, Peer
 
@@ -175,6 +176,7 @@ class World:
             slot.terminated = False
             slot.reason = None
             slot.ended_at = None
+            slot.blown = False
             slot.history.clear()
         self.steps = 0
         self.started = True
@@ -204,8 +206,14 @@ class World:
             slot.sim.apply(*act)
             if slot.task.history_window:
                 slot.history.append((slot.prev_state, slot.prev_action))
+            state = slot.sim.read()
+            if diverged(state):
+                # not a flight (NaN, 1e35 g): shown, to itself, to the other aircraft, the
+                # server and the record, at its last flown state; ``score`` ends it
+                slot.blown = True
+                state = slot.state
             slot.prev_state = slot.state
-            slot.state = slot.sim.read()
+            slot.state = state
             slot.prev_action = slot.action
             slot.action = np.array(act)
         self.steps += 1
@@ -256,7 +264,7 @@ class World:
         ctx.target = task.target_value(self.steps)
         if slot.target_links:
             self._show_targets(slot)
-        reason = task.termination(slot.state)
+        reason = "diverged" if slot.blown else task.termination(slot.state)
         if reason == "diverged":  # no flight to score: the step earns nothing
             reward = 0.0
         else:

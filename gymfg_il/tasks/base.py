@@ -37,11 +37,27 @@ _AGL = INDEX["altitude_agl_ft"]
 _ALT = INDEX["altitude_ft"]
 _VC = INDEX["airspeed_kts"]
 _P, _Q, _R, _NZ = (INDEX[n] for n in ("p_rad_s", "q_rad_s", "r_rad_s", "load_factor_g"))
+
+
 # beyond these JSBSim has diverged, not flown: no aircraft turns at 20 rad/s or pulls 30 g
 # (an A320 that struck the ground between two agent steps came back at 3e17 rad/s and 1e35 g,
 # then NaN)
 MAX_RATE_RAD_S = 20.0
 MAX_LOAD_G = 30.0
+
+
+def diverged(state: np.ndarray) -> bool:
+    """Whether ``state`` is not a flight: NaN, or rates and loads no aircraft reaches
+    (JSBSim blew up, typically on a ground strike between two agent steps)."""
+    # written so that NaN fails every comparison
+    return not (
+        abs(state[_AGL]) < math.inf
+        and abs(state[_VC]) < math.inf
+        and abs(state[_NZ]) < MAX_LOAD_G
+        and abs(state[_P]) < MAX_RATE_RAD_S
+        and abs(state[_Q]) < MAX_RATE_RAD_S
+        and abs(state[_R]) < MAX_RATE_RAD_S
+    )
 
 
 class Task:
@@ -167,17 +183,9 @@ class Task:
         """Why the aircraft must stop now (crashed, stalled, ...), or None to go on;
         ``diverged`` when the state is not a flight (NaN, or rates and loads no aircraft
         reaches: JSBSim blew up, typically on a ground strike between two agent steps)."""
-        agl = state[_AGL]
-        # written so that NaN fails every comparison
-        if not (
-            abs(agl) < math.inf
-            and abs(state[_VC]) < math.inf
-            and abs(state[_NZ]) < MAX_LOAD_G
-            and abs(state[_P]) < MAX_RATE_RAD_S
-            and abs(state[_Q]) < MAX_RATE_RAD_S
-            and abs(state[_R]) < MAX_RATE_RAD_S
-        ):
+        if diverged(state):
             return "diverged"
+        agl = state[_AGL]
         if agl < self._min_agl:
             return "crashed"
         if state[_VC] < self._min_vc:

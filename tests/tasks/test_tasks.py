@@ -130,26 +130,73 @@ def test_envelope_termination():
     assert task.termination(state(p_rad_s=4.0, load_factor_g=9.0)) is None  # an F-15 can
 
 
+def _blow_up(sim):
+    """Make ``sim`` return what JSBSim gave after an A320 struck the ground between two
+    steps: rates of 3e17 rad/s, loads of 1e35 g, then NaN."""
+    read = sim.read
+
+    def blown_up():
+        values = read()
+        values[INDEX["p_rad_s"]], values[INDEX["load_factor_g"]] = -3.3e17, -1.25e35
+        values[INDEX["altitude_agl_ft"]] = values[INDEX["heading_deg"]] = float("nan")
+        return values
+
+    sim.read = blown_up
+
+
 def test_a_diverged_simulation_ends_the_episode_instead_of_failing_it():
-    """An aircraft whose JSBSim state went NaN is terminated as diverged, with reward 0, and
-    the episode's record holds it (eval and collection go on to the next episode)."""
+    """An aircraft whose JSBSim state went NaN is terminated as diverged, with reward 0, at
+    its last flown state (no NaN in what is observed or recorded), and the next episode
+    flies: eval and collection go on."""
     from gymfg_il.envs.single import AircraftEnv
 
     env = AircraftEnv("heading", "A320", episode_time_s=5)
     env.reset(seed=0)
     slot = env.world.slots[0]
     env.step(np.array([0.0, 0.0, 0.0, 0.5]))
-    read = slot.sim.read
-
-    def blown_up():  # what JSBSim gave after an A320 struck the ground between two steps
-        values = read()
-        values[INDEX["p_rad_s"]], values[INDEX["altitude_agl_ft"]] = -3.3e17, float("nan")
-        return values
-
-    slot.sim.read = blown_up
-    _, reward, terminated, truncated, _ = env.step(np.array([0.0, 0.0, 0.0, 0.5]))
+    last = slot.state.copy()
+    _blow_up(slot.sim)
+    obs, reward, terminated, truncated, _ = env.step(np.array([0.0, 0.0, 0.0, 0.5]))
     assert terminated and not truncated and reward == 0.0
     assert slot.reason == "diverged"
+    assert np.array_equal(slot.state, last) and np.isfinite(obs).all()
+    del slot.sim.read  # the instance's own read again
+    obs, _ = env.reset(seed=1)
+    assert not slot.blown and np.isfinite(obs).all()
+    assert not env.step(np.array([0.0, 0.0, 0.0, 0.5]))[2]
+
+
+def test_a_diverged_opponent_is_never_shown_as_nan():
+    """Another team's aircraft that diverges is seen (opponent rows, reward targets) at its
+    last flown state as it ends, then absent, so a reward aimed at it stays finite."""
+    from gymfg_il import Team
+    from gymfg_il.aircraft import f15
+    from gymfg_il.controllers.agent import ConstantAgent
+    from gymfg_il.envs import OfflineEnv
+    from gymfg_il.tasks import DummyTask
+
+    def chase(ctx):
+        blue = ctx.targets.get("blue-1")
+        return 0.0 if blue is None else -geometry.distance_ft(ctx.state, blue) / 1000
+
+    red = Team(
+        "red",
+        [(c172p("red-1"), DummyTask(reward=chase))],
+        reward_function_targets={c172p("red-1"): [f15("blue-1")]},
+        episode_time_s=10,
+    )
+    blue = Team("blue", [(f15("blue-1"), DummyTask)])
+    env = OfflineEnv(opponents=[(blue, [ConstantAgent((0.0, 0.0, 0.0, 0.7))])])
+    env.reset(red, seed=2)
+    act = np.array([0.0, 0.0, 0.0, 0.7])
+    _, before, *_ = env.step(act)
+    _blow_up(env.world.by_callsign["blue-1"].sim)
+    _, rows, reward, terminated, _, info = env.step(act)  # red scores before blue
+    assert info["reasons"] == {"blue-1": "diverged"} and not terminated
+    assert np.isfinite(rows).all() and np.array_equal(rows, before)
+    assert math.isfinite(reward[0]) and reward[0] < 0  # aimed at blue's last flown position
+    _, rows, reward, *_ = env.step(act)
+    assert rows.shape == (0, 6) and reward[0] == 0.0  # gone, as a crashed aircraft is
 
 
 def test_geometry_and_orientation():
