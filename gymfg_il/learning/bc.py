@@ -9,12 +9,15 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.typecheck import type_problems
+
+if TYPE_CHECKING:
+    from gymfg_il.envs.flight import FlightSpec
 
 DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
 EPOCHS_AUTOPILOT, EPOCHS_PERSON = 60, 20  # the default epochs (TrainConfig.epochs)
@@ -250,6 +253,7 @@ def _train(
         assert frames.images is not None
         pconf = VisionConfig.for_observation(
             list(frames.observation_names),
+            _observation_high(flight),
             camera=cfg.camera,
             image_size=int(frames.images.shape[1]),
             frames=cfg.frames,
@@ -379,3 +383,15 @@ def plot_losses(train: list[float], val: list[float], path: Path, title: str) ->
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def _observation_high(flight: FlightSpec | None) -> list[float] | None:
+    """The upper observation bounds of ``flight``'s task (where its integrals saturate), or
+    None for a dataset without a flight spec."""
+    if flight is None:
+        return None
+    try:
+        task = flight.solo_aircraft.task_factory()()
+    except ConfigError:  # a spec of several aircraft: the policy saturates nothing
+        return None
+    return [float(v) for v in task.observation_bounds()[1]]

@@ -5,9 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.sim.properties import INDEX
 
 VIEWS = ("front", "chase")
-DERIVED = ("_target", "_error", "_integral")
+# the seen entries that wrap around 360 degrees: the eye estimates their cosine and sine
+# (a regression of 1 and 359 degrees to near-identical frames would answer 180)
+ANGULAR = frozenset({"heading_deg"})
 # what stays as it is when the aircraft rolls about its forward axis (the front camera's
 # optical axis): Euler pitch and heading, height, speeds, the roll rate, the position
 ROLL_INVARIANT = frozenset(
@@ -17,11 +20,12 @@ ROLL_INVARIANT = frozenset(
 
 
 def seen_for(names: list[str]) -> list[str]:
-    """The observation entries a vision policy estimates from its camera: all that describe
-    the aircraft (not the task's targets, nor the errors and integrals derived from them).
-    Some the camera shows well (attitude from the horizon, height from the ground's
-    texture), some hardly (an angle of attack): the hands learn how far to trust each."""
-    return [n for n in names if not n.endswith(DERIVED)]
+    """The observation entries a vision policy estimates from its camera: the aircraft's own
+    state (attitude, height, speeds, rates: ``sim.properties`` variables). Some the camera
+    shows well (attitude from the horizon, height from the ground's texture), some hardly
+    (an angle of attack): the hands learn how far to trust each. What else a task observes
+    is given, not seen (``VisionConfig``)."""
+    return [n for n in names if n in INDEX]
 
 
 @dataclass
@@ -33,7 +37,11 @@ class VisionConfig:
     as well as the camera shows each). The hands are an MLP that flies from those
     estimates, the task's targets (``target_names``), the errors to them and the errors'
     integrals, recomputed from the estimates in flight as the task computes them from the
-    truth (``error_*``, ``integral_*``). The hands never see the CNN's features: they learn
+    truth (``error_*``, ``integral_*``), and what else the task observes, given as the task
+    gives it (``given_*``): its instruments, which a pilot flying by sight reads too (an
+    approach's localizer and glidepath deviations, a waypoint's bearing and distance, the
+    lead's offsets in a formation, the error to an altitude the task assigns without
+    observing it, a turn's remaining degrees). The hands never see the CNN's features: they learn
     from the demonstrated states, with the noise the eye makes (its running error on the
     training frames, times ``noise_scale``) added to the states it estimates, and the eye
     learns from the frames, so each generalises as a state policy and a regression do.
@@ -61,8 +69,11 @@ class VisionConfig:
             variable's position in ``seen_names`` and its target's in ``target_names``.
         integral_names, integral_index: the errors' integrals (``<error>_integral``), summed
             in flight over ``dt``; integral_error: for each, its error's position in
-            ``error_names``.
+            ``error_names``; integral_limit: where the task saturates each (its observation
+            bound; 0: none known, no limit).
+        given_names, given_index: the rest of the observation, read as it is.
         angular: for each error, whether it wraps around 360 degrees (a heading).
+        seen_angular: for each seen entry, whether it wraps around 360 degrees (``ANGULAR``).
         aux_weight: weight of the eye's error in the training loss.
         roll_augment_deg: the front camera rolls with the aircraft about its optical axis,
             so a frame rotated by an angle is the frame of a roll that much larger: while
@@ -95,7 +106,11 @@ class VisionConfig:
     integral_names: list[str] = field(default_factory=list)
     integral_index: list[int] = field(default_factory=list)
     integral_error: list[int] = field(default_factory=list)
+    integral_limit: list[float] = field(default_factory=list)
+    given_names: list[str] = field(default_factory=list)
+    given_index: list[int] = field(default_factory=list)
     angular: list[bool] = field(default_factory=list)
+    seen_angular: list[bool] = field(default_factory=list)
     aux_weight: float = 1.0
     roll_augment_deg: float = 15.0
     augment_share: float = 0.5
@@ -116,14 +131,16 @@ class VisionConfig:
             )
         if not self.hidden or min(self.hidden) < 1 or not self.channels or min(self.channels) < 1:
             problems.append("hidden and channels must be non-empty lists of widths >= 1")
-        pairs = ("seen", "target", "error", "integral")
+        pairs = ("seen", "target", "error", "integral", "given")
         if any(len(getattr(self, f"{p}_names")) != len(getattr(self, f"{p}_index")) for p in pairs):
             problems.append(f"each of {', '.join(p + '_*' for p in pairs)} needs names and indices")
         n_err = len(self.error_names)
         if not len(self.error_seen) == len(self.error_target) == len(self.angular) == n_err:
             problems.append("error_seen, error_target and angular need one entry per error")
-        if len(self.integral_error) != len(self.integral_names):
-            problems.append("integral_error needs one entry per integral")
+        if not len(self.integral_error) == len(self.integral_limit) == len(self.integral_names):
+            problems.append("integral_error and integral_limit need one entry per integral")
+        if len(self.seen_angular) != len(self.seen_names):
+            problems.append("seen_angular needs one entry per seen entry")
         if not self.seen_names:
             problems.append("seen_names is empty: the camera must show the policy something")
         if not self.aux_weight > 0 or not self.noise_scale >= 0:
@@ -137,9 +154,13 @@ class VisionConfig:
             raise ConfigError("VisionConfig: " + "; ".join(problems))
 
     @classmethod
-    def for_observation(cls, names: list[str], **kwargs: object) -> VisionConfig:
-        """The config for a task observing ``names``: what the eye estimates, and which
-        errors and integrals the hands recompute from it."""
+    def for_observation(
+        cls, names: list[str], high: list[float] | None = None, **kwargs: object
+    ) -> VisionConfig:
+        """The config for a task observing ``names`` (``high``: the task's observation
+        bounds, ``Task.observation_bounds``, where its integrals saturate): what the eye
+        estimates, which errors and integrals the hands recompute from it, and what they
+        are given."""
         seen = seen_for(names)
         targets = [n for n in names if n.endswith("_target")]
         errors = [
@@ -151,7 +172,10 @@ class VisionConfig:
         ]
         integrals = [n for n in names if n.endswith("_integral") and n.removesuffix("_integral")
                      in errors]  # fmt: skip
+        derived = set(seen) | set(targets) | set(errors) | set(integrals)
+        given = [n for n in names if n not in derived]
         variables = [e.removesuffix("_error") for e in errors]
+        limits = [float(high[names.index(n)]) if high is not None else 0.0 for n in integrals]
         return cls(
             seen_names=seen,
             seen_index=[names.index(n) for n in seen],
@@ -164,6 +188,10 @@ class VisionConfig:
             integral_names=integrals,
             integral_index=[names.index(n) for n in integrals],
             integral_error=[errors.index(n.removesuffix("_integral")) for n in integrals],
-            angular=[v == "heading_deg" for v in variables],
+            integral_limit=limits,
+            given_names=given,
+            given_index=[names.index(n) for n in given],
+            angular=[v in ANGULAR for v in variables],
+            seen_angular=[n in ANGULAR for n in seen],
             **kwargs,  # type: ignore[arg-type]
         )

@@ -25,7 +25,9 @@ class VisionPolicy(NormalizedPolicy):
     error_target: torch.Tensor
     integral_index: torch.Tensor
     integral_error: torch.Tensor
+    integral_limit: torch.Tensor
     angular: torch.Tensor
+    seen_angular: torch.Tensor
     hands_index: torch.Tensor
     eye_error: torch.Tensor
     kept_when_rolled: torch.Tensor
@@ -47,19 +49,23 @@ class VisionPolicy(NormalizedPolicy):
             width = c
         side = config.image_size // config.pool // 2 ** len(config.channels)
         n_seen = len(config.seen_index)
+        # one output per seen entry (an angular one's cosine), then the angular ones' sines
         self.eye = nn.Sequential(
             *layers,
             nn.Flatten(),
             nn.Linear(width * side * side, 256),
             nn.GELU(),
-            nn.Linear(256, n_seen),
+            nn.Linear(256, n_seen + sum(config.seen_angular)),
         )
         for name in ("seen_index", "target_index", "error_index", "error_seen", "error_target",
                      "integral_index", "integral_error"):  # fmt: skip
             self.register_buffer(name, torch.as_tensor(getattr(config, name), dtype=torch.long))
         self.register_buffer("angular", torch.as_tensor(config.angular, dtype=torch.bool))
+        self.register_buffer("seen_angular", torch.as_tensor(config.seen_angular, dtype=torch.bool))
+        limit = [v if v > 0 else math.inf for v in config.integral_limit]
+        self.register_buffer("integral_limit", torch.as_tensor(limit, dtype=torch.float32))
         hands = [*config.seen_index, *config.target_index, *config.error_index]
-        hands += config.integral_index
+        hands += config.integral_index + config.given_index
         self.register_buffer("hands_index", torch.as_tensor(hands, dtype=torch.long))
         # the eye's running RMS error on the training frames (normalised), per seen entry
         self.register_buffer("eye_error", torch.zeros(n_seen))
@@ -77,14 +83,32 @@ class VisionPolicy(NormalizedPolicy):
 
     # -- the eye ---------------------------------------------------------------------------
     def look(self, images: torch.Tensor) -> torch.Tensor:
-        """Normalised estimates of ``seen_names`` from pooled frames (batch, frames, H, W, 3)
-        uint8 (``pool_frames``)."""
+        """The eye's outputs for pooled frames (batch, frames, H, W, 3) uint8
+        (``pool_frames``): ``seen_names`` normalised, an angular one's cosine in its place,
+        then the angular ones' sines (``_seen_raw`` reads them)."""
         b, f, h, w, _ = images.shape
         x = images.permute(0, 1, 4, 2, 3).reshape(b, f * 3, h, w).float() / 255.0 - 0.5
         return self.eye(x)
 
     def _seen_raw(self, estimate: torch.Tensor) -> torch.Tensor:
-        return estimate * self.obs_norm.std[self.seen_index] + self.obs_norm.mean[self.seen_index]
+        """Raw estimates of ``seen_names`` from the eye's outputs."""
+        idx, n = self.seen_index, len(self.seen_index)
+        raw = estimate[:, :n] * self.obs_norm.std[idx] + self.obs_norm.mean[idx]
+        if estimate.shape[1] == n:
+            return raw
+        angle = torch.rad2deg(torch.atan2(estimate[:, n:], estimate[:, :n][:, self.seen_angular]))
+        raw[:, self.seen_angular] = torch.remainder(angle, 360.0)
+        return raw
+
+    def _eye_truth(self, truth_raw: torch.Tensor) -> torch.Tensor:
+        """What the eye should output for raw ``seen_names`` values (``look``)."""
+        idx = self.seen_index
+        truth = (truth_raw - self.obs_norm.mean[idx]) / self.obs_norm.std[idx]
+        if not bool(self.seen_angular.any()):
+            return truth
+        rad = torch.deg2rad(truth_raw[:, self.seen_angular])
+        truth[:, self.seen_angular] = torch.cos(rad)
+        return torch.cat([truth, torch.sin(rad)], dim=1)
 
     def _errors(self, obs: torch.Tensor, seen: torch.Tensor) -> torch.Tensor:
         """Raw errors to the targets from raw seen values, as the task computes them."""
@@ -118,20 +142,25 @@ class VisionPolicy(NormalizedPolicy):
         if self.training:
             images, truth_raw, weight = self._rolled(images, truth_raw, weight)
         estimate = self.look(images)
-        truth = (truth_raw - self.obs_norm.mean[self.seen_index]) / self.obs_norm.std[
-            self.seen_index
-        ]
-        squared = (estimate - truth).pow(2) * weight
+        ang = self.seen_angular
+        weight = torch.cat([weight, weight[:, ang]], dim=1)
+        squared = (estimate - self._eye_truth(truth_raw)).pow(2) * weight
         eye_loss = squared.sum() / weight.sum()
         if self.training:
             with torch.no_grad():
-                rms = (squared.sum(dim=0) / weight.sum(dim=0).clamp_min(1.0)).sqrt()
+                n = len(self.seen_index)
+                mean = squared.sum(dim=0) / weight.sum(dim=0).clamp_min(1.0)
+                rms = mean[:n].sqrt()
+                # an angle's: the chord between estimate and truth on the unit circle (for
+                # small errors, the angle in radians), in degrees, normalised like the rest
+                chord = (mean[:n][ang] + mean[n:]).sqrt()
+                rms[ang] = torch.rad2deg(chord) / self.obs_norm.std[self.seen_index][ang]
                 fresh = bool((self.eye_error == 0).all())
                 self.eye_error.copy_(rms if fresh else 0.98 * self.eye_error + 0.02 * rms)
         noisy = obs.clone()
         if self.config.noise_scale and self.training:
             std = self.eye_error * self.obs_norm.std[self.seen_index] * self.config.noise_scale
-            seen = obs[:, self.seen_index] + torch.randn_like(std.expand_as(truth)) * std
+            seen = obs[:, self.seen_index] + torch.randn_like(std.expand_as(truth_raw)) * std
             noisy[:, self.seen_index] = seen
             noisy[:, self.error_index] = self._errors(obs, seen)
         predicted = self.fly(noisy)
@@ -189,8 +218,11 @@ class VisionPolicy(NormalizedPolicy):
         obs = obs.clone()
         seen = self._seen_raw(self.look(stack))
         errors = self._errors(obs, seen)
-        # the integrals count the current step's error, as the task's do
+        # the integrals count the current step's error and saturate, as the task's do
         integrals = integrals + errors[:, self.integral_error] * self.config.dt
+        integrals = torch.maximum(
+            torch.minimum(integrals, self.integral_limit), -self.integral_limit
+        )
         obs[:, self.seen_index] = seen
         obs[:, self.error_index] = errors
         obs[:, self.integral_index] = integrals

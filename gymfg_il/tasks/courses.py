@@ -186,6 +186,7 @@ class ApproachTask(ManeuverTask):
         "height_above_threshold_ft",
     )
     tracked_entry = ("altitude_ft", "glidepath_error_ft", 100.0)
+    integral_limit = 600.0
     glide_deg = 3.0
     decision_height_ft = 200.0
     hold_from_nm = 2.5
@@ -247,7 +248,8 @@ class ApproachTask(ManeuverTask):
         if step == 0:
             self._integral = 0.0
         else:
-            self._integral = max(-600.0, min(600.0, self._integral + speed_error * self.dt))
+            limit = self.integral_limit
+            self._integral = max(-limit, min(limit, self._integral + speed_error * self.dt))
         return [
             float(g["distance"]),
             float(g["offset"]),

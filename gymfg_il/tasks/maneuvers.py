@@ -80,9 +80,13 @@ class ManeuverTask(Task):
         self._step = -1
         self._extras: np.ndarray = np.zeros(len(self.extra_names))
 
+    # where an ``*_integral`` entry saturates (its observation bound, which a vision
+    # policy's recomputed integral follows)
+    integral_limit: ClassVar[float] = 6e4
+
     def _extra_bounds(self) -> tuple[list[float], list[float]]:
-        n = len(self.extra_names)
-        return [-1e6] * n, [1e6] * n
+        high = [self.integral_limit if n.endswith("_integral") else 1e6 for n in self.extra_names]
+        return [-v for v in high], high
 
     # -- what each maneuver defines --------------------------------------------------------
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
@@ -175,7 +179,8 @@ class TurnTask(ManeuverTask):
         self._last = heading
         alt_err = self.plan["altitude_ft"] - float(state[_ALT])
         if step:
-            self._integral = max(-6e4, min(6e4, self._integral + alt_err * self.dt))
+            limit = self.integral_limit
+            self._integral = max(-limit, min(limit, self._integral + alt_err * self.dt))
         return [self.plan["turn_deg"] - self._turned, alt_err, self._integral]
 
     def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
@@ -239,7 +244,8 @@ class ClimbTurnTask(ManeuverTask):
         if step == 0:
             self._integral = 0.0
         else:
-            self._integral = max(-6e4, min(6e4, self._integral + alt_err * self.dt))
+            limit = self.integral_limit
+            self._integral = max(-limit, min(limit, self._integral + alt_err * self.dt))
         hdg = self.plan["heading_deg"]
         return [self.plan["altitude_ft"], alt_err, self._integral, hdg, wrap(hdg - state[_HDG])]
 

@@ -2,6 +2,8 @@
 estimates and the task's targets), trained on a camera dataset and flown with the env's
 camera."""
 
+import math
+
 import numpy as np
 import pytest
 import torch
@@ -17,6 +19,8 @@ from gymfg_il.policies.configuration_vision import VisionConfig
 from gymfg_il.policies.modeling_vision import VisionPolicy, pool_frames
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.loop import Rollout
+from gymfg_il.sim.properties import INDEX
+from gymfg_il.tasks.library import TASK_FAMILIES, task_class
 
 
 @pytest.fixture(scope="module")
@@ -83,24 +87,64 @@ def test_pooling_is_the_block_mean_and_the_config_checks_its_sizes():
 
 def test_in_flight_errors_and_integrals_come_from_the_eyes_estimates():
     names = ["roll_deg", "heading_deg", "roll_deg_target", "roll_deg_error",
-             "roll_deg_error_integral", "heading_deg_target", "heading_deg_error"]  # fmt: skip
+             "roll_deg_error_integral", "heading_deg_target", "heading_deg_error",
+             "altitude_ft_error", "turn_remaining_deg"]  # fmt: skip
+    high = [180.0, 360.0, 180.0, 180.0, 0.6, 360.0, 180.0, 1e4, 360.0]
     cfg = VisionConfig.for_observation(
-        names, image_size=16, pool=1, channels=[4], hidden=[8], dt=0.1
+        names, high, image_size=16, pool=1, channels=[4], hidden=[8], dt=0.1
     )
     assert cfg.seen_names == ["roll_deg", "heading_deg"] and cfg.angular == [False, True]
+    assert cfg.seen_angular == [False, True] and cfg.integral_limit == [0.6]
+    # an error to a target the task does not observe, and its bookkeeping, are given
+    assert cfg.given_names == ["altitude_ft_error", "turn_remaining_deg"]
     unit = {"mean": np.zeros(len(names)), "std": np.ones(len(names))}
     policy = VisionPolicy(cfg, unit, {"mean": np.zeros(4), "std": np.ones(4)})
-    policy.look = lambda images: torch.tensor([[10.0, 350.0]])  # the eye reads these
+    a = np.deg2rad(350.0)  # the eye reads roll 10 and a heading of 350 (its cosine, sine)
+    policy.look = lambda images: torch.tensor([[10.0, np.cos(a), np.sin(a)]], dtype=torch.float32)
     flown = []
     policy.fly = lambda obs: (flown.append(obs.clone()), torch.zeros(1, 4))[1]
     # the observation's own state, errors and integral are truth the policy must not read
-    obs = torch.tensor([[0.0, 0.0, 12.5, 99.0, 99.0, 5.0, 99.0]])
+    obs = torch.tensor([[0.0, 0.0, 12.5, 99.0, 99.0, 5.0, 99.0, -42.0, 90.0]])
     frame = torch.zeros(1, 16, 16, 3, dtype=torch.uint8)
     _, state = policy.act((frame, obs))
     _, state = policy.act((frame, obs), state)
     seen = flown[-1][0]
-    assert seen[0] == 10.0 and seen[1] == 350.0  # the estimates
+    assert seen[0] == 10.0 and seen[1] == pytest.approx(350.0, abs=1e-4)  # the estimates
     assert seen[3] == pytest.approx(2.5)  # roll error: target 12.5 less the estimate 10
-    assert seen[6] == pytest.approx(15.0)  # heading error wraps: 5 - 350 is +15
+    assert seen[6] == pytest.approx(15.0, abs=1e-4)  # heading error wraps: 5 - 350 is +15
     assert seen[4] == pytest.approx(2 * 2.5 * 0.1)  # two steps of the error, times dt
     assert seen[2] == 12.5 and seen[5] == 5.0  # targets are read as they are
+    assert seen[7] == -42.0 and seen[8] == 90.0  # so is what is given
+    for _ in range(3):  # the integral saturates where the task's does (0.6 here)
+        _, state = policy.act((frame, obs), state)
+    assert flown[-1][0][4] == pytest.approx(0.6)
+
+
+def test_the_eye_learns_a_heading_as_a_point_on_the_circle():
+    """1 and 359 degrees are 2 apart: the eye's targets for them are near each other, and
+    its outputs read back as the heading."""
+    cfg = VisionConfig.for_observation(
+        ["roll_deg", "heading_deg"], image_size=16, pool=1, channels=[4], hidden=[8]
+    )
+    stats = {"mean": np.array([0.0, 180.0]), "std": np.array([10.0, 100.0])}
+    policy = VisionPolicy(cfg, stats, {"mean": np.zeros(4), "std": np.ones(4)})
+    raw = torch.tensor([[5.0, 1.0], [5.0, 359.0], [-20.0, 180.0]])
+    truth = policy._eye_truth(raw)
+    assert truth.shape == (3, 3)
+    assert torch.dist(truth[0], truth[1]) < 0.04  # 2 degrees of arc apart, not 3.58 std
+    back = policy._seen_raw(truth)
+    assert torch.allclose(back, raw, atol=1e-4)
+
+
+@pytest.mark.parametrize("family", sorted(TASK_FAMILIES))
+def test_a_vision_policy_reads_every_entry_a_task_observes(family):
+    """Seen, a target, recomputed, or given: no observation entry is left out of the hands'
+    inputs, and only the aircraft's own state is left to the eye."""
+    task = task_class(family)()
+    names = list(task.observation_names)
+    cfg = VisionConfig.for_observation(names, [float(v) for v in task.observation_bounds()[1]])
+    parts = [cfg.seen_names, cfg.target_names, cfg.error_names, cfg.integral_names,
+             cfg.given_names]  # fmt: skip
+    assert sorted(n for part in parts for n in part) == sorted(names)
+    assert all(n in INDEX for n in cfg.seen_names)
+    assert all(0 < v < math.inf for v in cfg.integral_limit)
