@@ -1,15 +1,16 @@
 #!/bin/bash
-# A vision policy against the state policy on roll, c172p, default flags (README, "Seeing").
-# Usage: bash docs/experiments/vision.sh OUT [DEMOS] [COLLECT_SEED] [EVAL_SEED ...]
+# A vision policy against the state policy on roll (or TASK), c172p, default flags (README, "Seeing").
+# Usage: [TASK=heading] bash docs/experiments/vision.sh OUT [DEMOS] [COLLECT_SEED] [EVAL_SEED ...]
 # Prints each eval's table and the vision policy's share of the state policy's return.
 set -euo pipefail
 export HF_HUB_OFFLINE=1
 OUT=${1:-runs/experiments/vision}
 DEMOS=${2:-40}
+TASK=${TASK:-roll}
 SEED=${3:-1000}
 shift 3 || true
 EVAL_SEEDS=${*:-9000}
-python -m gymfg_il.collect autopilot --task roll --episodes "$DEMOS" --seed "$SEED" --images front \
+python -m gymfg_il.collect autopilot --task "$TASK" --episodes "$DEMOS" --seed "$SEED" --images front \
   --workers 2 --out "$OUT/demos" --no-progress > /dev/null
 python -m gymfg_il.train bc --dataset "$OUT/demos/dataset" --out "$OUT/state" --no-progress | grep "^trained"
 python -m gymfg_il.train bc --dataset "$OUT/demos/dataset" --policy vision --out "$OUT/vision" \

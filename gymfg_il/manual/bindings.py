@@ -149,3 +149,17 @@ def from_table(cls: type, table: dict[str, Any] | None, where: str) -> Any:
     if unknown:
         raise ConfigError(f"{where}: unknown keys {unknown}; known: {sorted(known)}")
     return cls(**table)
+
+
+def deflect(neutral: float, v: float) -> float:
+    """The surface command of a stick (or mouse) deflected by ``v`` in [-1, 1] from its
+    ``neutral`` (the trim): full travel either way is the full command, as a trimmed
+    aircraft's stick keeps its full travel (trim 0.18: -1 -> -1.0, 0 -> 0.18, +1 -> +1.0)."""
+    return neutral + v * (1.0 - neutral if v > 0 else 1.0 + neutral)
+
+
+def deflection(neutral: float, command: float) -> float:
+    """The deflection ``v`` that ``deflect(neutral, v)`` turns into ``command`` (how far a
+    pilot aiming at a command moves the stick)."""
+    span = 1.0 - neutral if command > neutral else 1.0 + neutral
+    return (command - neutral) / span if span > 0 else 0.0

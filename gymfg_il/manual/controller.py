@@ -8,8 +8,9 @@ at every ``handle`` and ``act``.
 
 The stick's neutral is the episode's start controls (``start_from``: a trimmed start's trim),
 as trim sets a real stick's neutral: released keys centre the surfaces on it, the mouse
-pointer and the joystick deflect from it, and the centre key returns to it. The action is
-still the whole command (neutral plus deflection), so a hands-off pilot flies the trim.
+pointer and the joystick deflect from it with their full travel (``bindings.deflect``: full
+stick either way is the full command), and the centre key returns to it. The action is the
+whole command, so a hands-off pilot flies the trim.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from gymfg_il.manual.bindings import (
     JoystickBindings,
     KeyboardBindings,
     MouseBindings,
+    deflect,
 )
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
 
@@ -205,7 +207,7 @@ class ManualController:
         for idx, v in ((0, x), (1, y)):
             v = max(-1.0, min(1.0, v))
             v = 0.0 if abs(v) < m.dead_zone else v
-            self.values[idx] = min(1.0, max(-1.0, self.neutral[idx] + v))
+            self.values[idx] = deflect(self.neutral[idx], v)
 
     def _joystick_event(self, pg: Any, ev: Any) -> list[str]:
         if ev.type == pg.JOYDEVICEADDED:
@@ -227,7 +229,7 @@ class ManualController:
                     idx = ("aileron", "elevator", "rudder", "throttle").index(control)
                     value = self.joy.shape(control, ev.value)
                     if idx < 3:  # a surface deflects from its neutral; the throttle is absolute
-                        value = min(1.0, max(-1.0, self.neutral[idx] + value))
+                        value = deflect(self.neutral[idx], max(-1.0, min(1.0, value)))
                     self.values[idx] = value
         elif ev.type == pg.JOYBUTTONDOWN:
             command = self.joy.buttons.get(ev.button)

@@ -31,7 +31,12 @@ import numpy as np
 
 from gymfg_il.controllers.agent import Agent
 from gymfg_il.errors import ConfigError
-from gymfg_il.manual.bindings import JoystickBindings, KeyboardBindings, MouseBindings
+from gymfg_il.manual.bindings import (
+    JoystickBindings,
+    KeyboardBindings,
+    MouseBindings,
+    deflection,
+)
 from gymfg_il.manual.controller import DEVICES, ManualController
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
 
@@ -240,7 +245,7 @@ class SyntheticPilot:
         out = []
         for control, axis in self.joy.axes.items():
             i = CONTROLS.index(control)
-            aim = float(want[i]) - (self.neutral[i] if i < 3 else 0.0)
+            aim = deflection(self.neutral[i], float(want[i])) if i < 3 else float(want[i])
             raw = self._raw(control, aim + self.rng.normal(0.0, self.skill.tremor))
             raw = round(raw / self.skill.quantum) * self.skill.quantum
             raw = max(-1.0, min(1.0, raw))
@@ -258,8 +263,8 @@ class SyntheticPilot:
     def _mouse(self, want: np.ndarray) -> list[Any]:
         m = self.mouse
         cx, cy = self.window_size[0] / 2, self.window_size[1] / 2
-        x = float(want[0] - self.neutral[0]) + self.rng.normal(0.0, self.skill.tremor)
-        y = float(want[1] - self.neutral[1]) + self.rng.normal(0.0, self.skill.tremor)
+        x = deflection(self.neutral[0], float(want[0])) + self.rng.normal(0.0, self.skill.tremor)
+        y = deflection(self.neutral[1], float(want[1])) + self.rng.normal(0.0, self.skill.tremor)
         if m.invert_elevator:
             y = -y
         pos = (round(cx + x * m.span_px), round(cy - y * m.span_px))

@@ -13,6 +13,7 @@ from gymfg_il.collectors.manual import ManualSession
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.data import load_frames
+from gymfg_il.manual.bindings import deflect, deflection
 
 SPEC = FlightSpec.solo("c172p", "altitude", episode_time_s=3, agent_hz=30)  # 90 frames an episode
 
@@ -70,11 +71,12 @@ def test_mouse_is_the_stick(tmp_path):
     script = {1: [lambda: key(pygame.K_SPACE)], 5: [move], 200: [lambda: key(pygame.K_q)]}
     run(tmp_path, script, device="mouse")
     frames = load_frames(tmp_path / "dataset")
-    # 100 px right of centre, 50 px up, span 200 px: aileron 0.5, elevator +0.25 (nose down),
-    # from the stick's neutral (the trim the episode starts with, flown at frame 0)
+    # 100 px right of centre, 50 px up, span 200 px: aileron 0.5, elevator +0.25 (nose down)
+    # of the travel from the stick's neutral (the trim the episode starts with, flown at
+    # frame 0) to full deflection
     trim = frames.action[0]
-    assert frames.action[4, 0] == pytest.approx(trim[0] + 0.5)
-    assert frames.action[4, 1] == pytest.approx(trim[1] + 0.25)
+    assert frames.action[4, 0] == pytest.approx(trim[0] + 0.5 * (1 - trim[0]))
+    assert frames.action[4, 1] == pytest.approx(trim[1] + 0.25 * (1 - trim[1]))
     assert frames.action[2, 0] == trim[0] and trim[1] > 0.1  # the c172p's trimmed elevator
 
 
@@ -100,10 +102,10 @@ def test_joystick_axes_buttons_and_unplugging(tmp_path):
     a = frames.action
     shaped = ((0.6 - 0.05) / 0.95) * 0.7 + 0.3 * ((0.6 - 0.05) / 0.95) ** 3
     trim = a[0]  # the stick deflects from its neutral, the trim flown at frame 0
-    assert a[4, 0] == pytest.approx(trim[0] + shaped, rel=1e-6)
+    assert a[4, 0] == pytest.approx(deflect(trim[0], shaped), rel=1e-6)
     assert a[4, 1] == trim[1]  # inside the dead zone
     assert a[29, 0] == trim[0]  # unplugged: centred, and the session went on
-    assert a[39, 0] == pytest.approx(trim[0] + shaped, rel=1e-6)  # plugged back in
+    assert a[39, 0] == pytest.approx(deflect(trim[0], shaped), rel=1e-6)  # plugged back in
     assert len(a) == 59  # the button ended and saved the episode
 
 
@@ -235,3 +237,15 @@ def test_the_dataset_helper_builds_on_request_and_outlives_a_crash(tmp_path, cap
     assert not updater.close() and updater.failures == 2  # the session hears why, each time
     assert "not a readable GymFG trajectory log" in caplog.text and "collect recover" in caplog.text
     assert len(load_frames(tmp_path / "dataset").episodes["gymfg/seed"]) == 2  # nothing lost
+
+
+def test_a_trimmed_stick_keeps_its_full_travel():
+    """Full stick either way is the full command whatever the trim; a pilot aiming at a
+    command finds the deflection that gives it."""
+    for trim in (0.18, -0.3, 0.0):
+        assert deflect(trim, 0.0) == trim
+        assert deflect(trim, 1.0) == 1.0 and deflect(trim, -1.0) == -1.0
+        for command in (-1.0, -0.5, trim, 0.4, 1.0):
+            v = deflection(trim, command)
+            assert -1.0 <= v <= 1.0 and deflect(trim, v) == pytest.approx(command)
+    assert deflect(0.18, 0.5) == pytest.approx(0.59) and deflect(0.18, -0.5) == -0.41
