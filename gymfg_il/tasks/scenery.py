@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import INDEX
 
 KINDS = ("runway", "gate", "aircraft")
@@ -66,9 +67,15 @@ def landmarks_of(task: Any, plan: dict[str, Any] | None, step: int) -> list[Land
 
 
 def task_landmarks(task: str, plan: dict[str, Any] | None, step: int) -> list[Landmark]:
-    """``landmarks_of`` for a task named as the library names it (``waypoints``, ...)."""
+    """``landmarks_of`` for a task named as the library names it (``waypoints``, ...); none
+    for a task the library does not know (a user's own maneuver: a recording or a video
+    must not stop on its scenery)."""
     if not plan:
         return []
     from gymfg_il.tasks.library import task_class
 
-    return landmarks_of(task_class(task), plan, step)
+    try:
+        cls = task_class(task)
+    except ConfigError:
+        return []
+    return landmarks_of(cls, plan, step)

@@ -284,3 +284,26 @@ def test_scene_draws_what_a_maneuver_places(task, tmp_path):
             assert np.allclose([leads[k]["translation"][c] for c in "xyz"], want, atol=1e-6)
         moved = np.subtract(*[[leads[i]["translation"][c] for c in "xy"] for i in (steps, 0)])
         assert np.linalg.norm(moved) > 100  # 3 s of the lead's flight
+
+
+def test_a_users_own_maneuver_records_without_scenery(tmp_path):
+    """A maneuver the library does not know (a user's subclass, named its own way) has a
+    plan but no landmarks the writer can look up: the log is written, with no scenery."""
+    from gymfg_il.tasks.maneuvers import TurnTask
+
+    class MyTurn(TurnTask):
+        name = "my-turn"
+
+    env = Recorder(OfflineEnv(), tmp_path)
+    env.reset(Team("ego", [(c172p("ego"), MyTurn)], episode_time_s=1), seed=0)
+    done = False
+    while not done:
+        *_, terminated, truncated, _ = env.step(np.array([0.0, 0.0, 0.0, 0.6]))
+        done = terminated or truncated
+    path = env.log
+    env.close()
+    log = read_log(path)
+    assert log.complete_episodes[0].start_of("ego")["plan"]  # a maneuver's plan, recorded
+    msgs, _ = messages(path)
+    (scene,) = msgs["/gymfg/ego/scene"]
+    assert "ego/scenery" not in {e["id"] for e in scene["entities"]}
