@@ -98,7 +98,7 @@ def video_encoder() -> Any:
 
     Lossless because a vision policy flies by the camera's own frames: trained on frames
     that went through lossy H.264 (crf 23, yuv420p: 2.0 levels off on average, up to 32), its
-    roll estimate on the camera's frames was off by 0.59 deg RMS against 0.23 on decoded ones,
+    roll estimate on the camera's frames was off by 0.59 deg RMS against 0.25 on decoded ones,
     with heading-dependent biases up to 1.2 deg. Lossless frames are within one level of the
     drawn ones (the colour conversion), encode as fast, and take ~7.6 KiB a 128x128 frame
     against ~2.5 (measured here)."""

@@ -200,11 +200,11 @@ class TrajectoryWriter:
     def _draw_starts(self, starts: Sequence[Start]) -> None:
         """Foxglove's 3D view at the reset: anchor the ``enu`` frame at the first aircraft,
         place every aircraft, draw it and its task's target (``recording.foxglove``)."""
+        self._aims, self._leads = {}, {}  # no episode's before it moves on in this one
         if not starts:
             return
         lat, lon, alt_ft = starts[0].state[:3].tolist()
         self._frame = fg.LocalFrame(lat, lon, alt_ft * _FT_TO_M)
-        self._aims, self._leads = {}, {}
         for s in starts:
             if s.callsign not in self._scenes:
                 continue

@@ -42,10 +42,9 @@ def test_hands_off_flight_from_a_reset_holds_altitude_and_pitch(model):
         )
         sim.reset(ic, profile.cruise_throttle)
         worst_h, worst_q = _hands_off(sim)
-        assert worst_h < 50.0, (model, ic, worst_h)
-        # the engines start in their steady state at the trim's throttle (JSBSim starts
-        # them at full throttle's: the c172p then pitched at 0.019-0.021 rad/s)
-        assert worst_q < 0.02, (model, ic, worst_q)
+        # the issue asked for 50 ft and 0.02 rad/s; the engines start in their steady state
+        # at the trim's throttle (JSBSim starts them at full throttle's: the c172p then
+        # pitched at 0.019-0.021 rad/s), and all three do far better
         assert worst_h < (5.0 if model == "c172p" else 2.0), (model, ic, worst_h)
         assert worst_q < (0.011 if model == "c172p" else 0.003), (model, ic, worst_q)
 
