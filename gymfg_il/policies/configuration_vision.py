@@ -1,4 +1,5 @@
-"""Configuration of the vision policy: camera frames and the task's targets in, action out."""
+"""Configuration of the vision policy: camera frames, the task's targets and its instruments
+in, action out."""
 
 from __future__ import annotations
 
@@ -8,9 +9,9 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import INDEX
 
 VIEWS = ("front", "chase")
-# the seen entries that wrap around 360 degrees: the eye estimates their cosine and sine
-# (a regression of 1 and 359 degrees to near-identical frames would answer 180)
-ANGULAR = frozenset({"heading_deg"})
+# the aircraft's state that no frame shows: the ground's checkerboard looks the same every
+# 90 degrees of heading, so the heading comes from the compass, as a pilot's does
+INSTRUMENTS = frozenset({"heading_deg"})
 # what stays as it is when the aircraft rolls about its forward axis (the front camera's
 # optical axis): Euler pitch and heading, height, speeds, the roll rate, the position
 ROLL_INVARIANT = frozenset(
@@ -21,11 +22,11 @@ ROLL_INVARIANT = frozenset(
 
 def seen_for(names: list[str]) -> list[str]:
     """The observation entries a vision policy estimates from its camera: the aircraft's own
-    state (attitude, height, speeds, rates: ``sim.properties`` variables). Some the camera
-    shows well (attitude from the horizon, height from the ground's texture), some hardly
-    (an angle of attack): the hands learn how far to trust each. What else a task observes
-    is given, not seen (``VisionConfig``)."""
-    return [n for n in names if n in INDEX]
+    state (attitude, height, speeds, rates: ``sim.properties`` variables) but its heading
+    (``INSTRUMENTS``). Some the camera shows well (attitude from the horizon, height from
+    the ground's texture), some hardly (an angle of attack): the hands learn how far to
+    trust each. What else a task observes is given, not seen (``VisionConfig``)."""
+    return [n for n in names if n in INDEX and n not in INSTRUMENTS]
 
 
 @dataclass
@@ -38,10 +39,14 @@ class VisionConfig:
     estimates, the task's targets (``target_names``), the errors to them and the errors'
     integrals, recomputed from the estimates in flight as the task computes them from the
     truth (``error_*``, ``integral_*``), and what else the task observes, given as the task
-    gives it (``given_*``): its instruments, which a pilot flying by sight reads too (an
-    approach's localizer and glidepath deviations, a waypoint's bearing and distance, the
-    lead's offsets in a formation, the error to an altitude the task assigns without
-    observing it, a turn's remaining degrees). The hands never see the CNN's features: they learn
+    gives it (``given_*``): its instruments, which a pilot flying by sight reads too (the
+    compass's heading and the errors to a heading target, an approach's localizer and
+    glidepath deviations, a waypoint's bearing and distance, the lead's offsets in a
+    formation, the error to an altitude the task assigns without observing it, a turn's
+    remaining degrees). Heading from the camera (as cosine and sine: a regression of 1 and
+    359 degrees answers 180) flew the heading task at 15 % of the state policy's return,
+    6 % success, 20 demonstrations: the ground looks the same every 90 degrees; from the
+    compass, 101 % and 16 of 16. The hands never see the CNN's features: they learn
     from the demonstrated states, with the noise the eye makes (its running error on the
     training frames, times ``noise_scale``) added to the states it estimates, and the eye
     learns from the frames, so each generalises as a state policy and a regression do.
@@ -72,8 +77,6 @@ class VisionConfig:
             ``error_names``; integral_limit: where the task saturates each (its observation
             bound; 0: none known, no limit).
         given_names, given_index: the rest of the observation, read as it is.
-        angular: for each error, whether it wraps around 360 degrees (a heading).
-        seen_angular: for each seen entry, whether it wraps around 360 degrees (``ANGULAR``).
         aux_weight: weight of the eye's error in the training loss.
         roll_augment_deg: the front camera rolls with the aircraft about its optical axis,
             so a frame rotated by an angle is the frame of a roll that much larger: while
@@ -109,8 +112,6 @@ class VisionConfig:
     integral_limit: list[float] = field(default_factory=list)
     given_names: list[str] = field(default_factory=list)
     given_index: list[int] = field(default_factory=list)
-    angular: list[bool] = field(default_factory=list)
-    seen_angular: list[bool] = field(default_factory=list)
     aux_weight: float = 1.0
     roll_augment_deg: float = 15.0
     augment_share: float = 0.5
@@ -135,12 +136,10 @@ class VisionConfig:
         if any(len(getattr(self, f"{p}_names")) != len(getattr(self, f"{p}_index")) for p in pairs):
             problems.append(f"each of {', '.join(p + '_*' for p in pairs)} needs names and indices")
         n_err = len(self.error_names)
-        if not len(self.error_seen) == len(self.error_target) == len(self.angular) == n_err:
-            problems.append("error_seen, error_target and angular need one entry per error")
+        if not len(self.error_seen) == len(self.error_target) == n_err:
+            problems.append("error_seen and error_target need one entry per error")
         if not len(self.integral_error) == len(self.integral_limit) == len(self.integral_names):
             problems.append("integral_error and integral_limit need one entry per integral")
-        if len(self.seen_angular) != len(self.seen_names):
-            problems.append("seen_angular needs one entry per seen entry")
         if not self.seen_names:
             problems.append("seen_names is empty: the camera must show the policy something")
         if not self.aux_weight > 0 or not self.noise_scale >= 0:
@@ -191,7 +190,5 @@ class VisionConfig:
             integral_limit=limits,
             given_names=given,
             given_index=[names.index(n) for n in given],
-            angular=[v in ANGULAR for v in variables],
-            seen_angular=[n in ANGULAR for n in seen],
             **kwargs,  # type: ignore[arg-type]
         )

@@ -1,7 +1,8 @@
 """The vision policy: an eye (a CNN over stacked camera frames that estimates the aircraft's
 state the task observes) and hands (an MLP that flies from those estimates and the task's
-targets). Trained together by behaviour cloning; in flight the agent hands it the env's
-camera frame beside the observation (``policies.agent``), of which it reads only the targets.
+targets and instruments). Trained together by behaviour cloning; in flight the agent hands
+it the env's camera frame beside the observation (``policies.agent``), of which it reads
+only the targets and what is given (``VisionConfig``).
 """
 
 from __future__ import annotations
@@ -26,8 +27,6 @@ class VisionPolicy(NormalizedPolicy):
     integral_index: torch.Tensor
     integral_error: torch.Tensor
     integral_limit: torch.Tensor
-    angular: torch.Tensor
-    seen_angular: torch.Tensor
     hands_index: torch.Tensor
     eye_error: torch.Tensor
     kept_when_rolled: torch.Tensor
@@ -49,19 +48,16 @@ class VisionPolicy(NormalizedPolicy):
             width = c
         side = config.image_size // config.pool // 2 ** len(config.channels)
         n_seen = len(config.seen_index)
-        # one output per seen entry (an angular one's cosine), then the angular ones' sines
         self.eye = nn.Sequential(
             *layers,
             nn.Flatten(),
             nn.Linear(width * side * side, 256),
             nn.GELU(),
-            nn.Linear(256, n_seen + sum(config.seen_angular)),
+            nn.Linear(256, n_seen),
         )
         for name in ("seen_index", "target_index", "error_index", "error_seen", "error_target",
                      "integral_index", "integral_error"):  # fmt: skip
             self.register_buffer(name, torch.as_tensor(getattr(config, name), dtype=torch.long))
-        self.register_buffer("angular", torch.as_tensor(config.angular, dtype=torch.bool))
-        self.register_buffer("seen_angular", torch.as_tensor(config.seen_angular, dtype=torch.bool))
         limit = [v if v > 0 else math.inf for v in config.integral_limit]
         self.register_buffer("integral_limit", torch.as_tensor(limit, dtype=torch.float32))
         hands = [*config.seen_index, *config.target_index, *config.error_index]
@@ -83,44 +79,25 @@ class VisionPolicy(NormalizedPolicy):
 
     # -- the eye ---------------------------------------------------------------------------
     def look(self, images: torch.Tensor) -> torch.Tensor:
-        """The eye's outputs for pooled frames (batch, frames, H, W, 3) uint8
-        (``pool_frames``): ``seen_names`` normalised, an angular one's cosine in its place,
-        then the angular ones' sines (``_seen_raw`` reads them)."""
+        """Normalised estimates of ``seen_names`` from pooled frames (batch, frames, H, W, 3)
+        uint8 (``pool_frames``)."""
         b, f, h, w, _ = images.shape
         x = images.permute(0, 1, 4, 2, 3).reshape(b, f * 3, h, w).float() / 255.0 - 0.5
         return self.eye(x)
 
     def _seen_raw(self, estimate: torch.Tensor) -> torch.Tensor:
-        """Raw estimates of ``seen_names`` from the eye's outputs."""
-        idx, n = self.seen_index, len(self.seen_index)
-        raw = estimate[:, :n] * self.obs_norm.std[idx] + self.obs_norm.mean[idx]
-        if estimate.shape[1] == n:
-            return raw
-        angle = torch.rad2deg(torch.atan2(estimate[:, n:], estimate[:, :n][:, self.seen_angular]))
-        raw[:, self.seen_angular] = torch.remainder(angle, 360.0)
-        return raw
-
-    def _eye_truth(self, truth_raw: torch.Tensor) -> torch.Tensor:
-        """What the eye should output for raw ``seen_names`` values (``look``)."""
-        idx = self.seen_index
-        truth = (truth_raw - self.obs_norm.mean[idx]) / self.obs_norm.std[idx]
-        if not bool(self.seen_angular.any()):
-            return truth
-        rad = torch.deg2rad(truth_raw[:, self.seen_angular])
-        truth[:, self.seen_angular] = torch.cos(rad)
-        return torch.cat([truth, torch.sin(rad)], dim=1)
+        return estimate * self.obs_norm.std[self.seen_index] + self.obs_norm.mean[self.seen_index]
 
     def _errors(self, obs: torch.Tensor, seen: torch.Tensor) -> torch.Tensor:
-        """Raw errors to the targets from raw seen values, as the task computes them."""
+        """Raw errors to the targets from raw seen values, as the task computes them (none
+        wraps: the heading is an instrument, ``configuration_vision.INSTRUMENTS``)."""
         targets = obs[:, self.target_index]
-        err = targets[:, self.error_target] - seen[:, self.error_seen]
-        wrapped = torch.remainder(err + 180.0, 360.0) - 180.0
-        return torch.where(self.angular, wrapped, err)
+        return targets[:, self.error_target] - seen[:, self.error_seen]
 
     # -- the hands -------------------------------------------------------------------------
     def fly(self, obs: torch.Tensor) -> torch.Tensor:
         """Normalised action from a raw observation (of which the hands read the seen
-        entries, the targets, the errors and their integrals)."""
+        entries, the targets, the errors and their integrals, and what is given)."""
         return self.hands(self.obs_norm(obs)[:, self.hands_index])
 
     def forward(self, images: torch.Tensor, obs: torch.Tensor) -> torch.Tensor:
@@ -142,19 +119,14 @@ class VisionPolicy(NormalizedPolicy):
         if self.training:
             images, truth_raw, weight = self._rolled(images, truth_raw, weight)
         estimate = self.look(images)
-        ang = self.seen_angular
-        weight = torch.cat([weight, weight[:, ang]], dim=1)
-        squared = (estimate - self._eye_truth(truth_raw)).pow(2) * weight
+        truth = (truth_raw - self.obs_norm.mean[self.seen_index]) / self.obs_norm.std[
+            self.seen_index
+        ]
+        squared = (estimate - truth).pow(2) * weight
         eye_loss = squared.sum() / weight.sum()
         if self.training:
             with torch.no_grad():
-                n = len(self.seen_index)
-                mean = squared.sum(dim=0) / weight.sum(dim=0).clamp_min(1.0)
-                rms = mean[:n].sqrt()
-                # an angle's: the chord between estimate and truth on the unit circle (for
-                # small errors, the angle in radians), in degrees, normalised like the rest
-                chord = (mean[:n][ang] + mean[n:]).sqrt()
-                rms[ang] = torch.rad2deg(chord) / self.obs_norm.std[self.seen_index][ang]
+                rms = (squared.sum(dim=0) / weight.sum(dim=0).clamp_min(1.0)).sqrt()
                 fresh = bool((self.eye_error == 0).all())
                 self.eye_error.copy_(rms if fresh else 0.98 * self.eye_error + 0.02 * rms)
         noisy = obs.clone()

@@ -93,47 +93,31 @@ def test_in_flight_errors_and_integrals_come_from_the_eyes_estimates():
     cfg = VisionConfig.for_observation(
         names, high, image_size=16, pool=1, channels=[4], hidden=[8], dt=0.1
     )
-    assert cfg.seen_names == ["roll_deg", "heading_deg"] and cfg.angular == [False, True]
-    assert cfg.seen_angular == [False, True] and cfg.integral_limit == [0.6]
-    # an error to a target the task does not observe, and its bookkeeping, are given
-    assert cfg.given_names == ["altitude_ft_error", "turn_remaining_deg"]
+    assert cfg.seen_names == ["roll_deg"] and cfg.integral_limit == [0.6]
+    assert cfg.target_names == ["roll_deg_target", "heading_deg_target"]
+    # the compass, an error to a target the task does not observe, and its bookkeeping
+    assert cfg.given_names == [
+        "heading_deg", "heading_deg_error", "altitude_ft_error", "turn_remaining_deg"
+    ]  # fmt: skip
     unit = {"mean": np.zeros(len(names)), "std": np.ones(len(names))}
     policy = VisionPolicy(cfg, unit, {"mean": np.zeros(4), "std": np.ones(4)})
-    a = np.deg2rad(350.0)  # the eye reads roll 10 and a heading of 350 (its cosine, sine)
-    policy.look = lambda images: torch.tensor([[10.0, np.cos(a), np.sin(a)]], dtype=torch.float32)
+    policy.look = lambda images: torch.tensor([[10.0]])  # the eye reads a roll of 10
     flown = []
     policy.fly = lambda obs: (flown.append(obs.clone()), torch.zeros(1, 4))[1]
-    # the observation's own state, errors and integral are truth the policy must not read
-    obs = torch.tensor([[0.0, 0.0, 12.5, 99.0, 99.0, 5.0, 99.0, -42.0, 90.0]])
+    # the observation's own roll, its error and integral are truth the policy must not read
+    obs = torch.tensor([[0.0, 350.0, 12.5, 99.0, 99.0, 5.0, 15.0, -42.0, 90.0]])
     frame = torch.zeros(1, 16, 16, 3, dtype=torch.uint8)
     _, state = policy.act((frame, obs))
     _, state = policy.act((frame, obs), state)
     seen = flown[-1][0]
-    assert seen[0] == 10.0 and seen[1] == pytest.approx(350.0, abs=1e-4)  # the estimates
+    assert seen[0] == 10.0  # the estimate
     assert seen[3] == pytest.approx(2.5)  # roll error: target 12.5 less the estimate 10
-    assert seen[6] == pytest.approx(15.0, abs=1e-4)  # heading error wraps: 5 - 350 is +15
     assert seen[4] == pytest.approx(2 * 2.5 * 0.1)  # two steps of the error, times dt
     assert seen[2] == 12.5 and seen[5] == 5.0  # targets are read as they are
-    assert seen[7] == -42.0 and seen[8] == 90.0  # so is what is given
+    assert seen[[1, 6, 7, 8]].tolist() == [350.0, 15.0, -42.0, 90.0]  # so is what is given
     for _ in range(3):  # the integral saturates where the task's does (0.6 here)
         _, state = policy.act((frame, obs), state)
     assert flown[-1][0][4] == pytest.approx(0.6)
-
-
-def test_the_eye_learns_a_heading_as_a_point_on_the_circle():
-    """1 and 359 degrees are 2 apart: the eye's targets for them are near each other, and
-    its outputs read back as the heading."""
-    cfg = VisionConfig.for_observation(
-        ["roll_deg", "heading_deg"], image_size=16, pool=1, channels=[4], hidden=[8]
-    )
-    stats = {"mean": np.array([0.0, 180.0]), "std": np.array([10.0, 100.0])}
-    policy = VisionPolicy(cfg, stats, {"mean": np.zeros(4), "std": np.ones(4)})
-    raw = torch.tensor([[5.0, 1.0], [5.0, 359.0], [-20.0, 180.0]])
-    truth = policy._eye_truth(raw)
-    assert truth.shape == (3, 3)
-    assert torch.dist(truth[0], truth[1]) < 0.04  # 2 degrees of arc apart, not 3.58 std
-    back = policy._seen_raw(truth)
-    assert torch.allclose(back, raw, atol=1e-4)
 
 
 @pytest.mark.parametrize("family", sorted(TASK_FAMILIES))
