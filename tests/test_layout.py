@@ -10,7 +10,7 @@ ROOT = Path(__file__).resolve().parents[1] / "gymfg_il"
 
 # bottom to top; a package may import from its own layer and the ones before it
 LAYERS = [
-    {"errors", "typecheck"},
+    {"errors", "typecheck", "names"},
     {"aircraft", "workers"},
     {"sim"},
     {"tasks"},
