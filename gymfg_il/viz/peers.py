@@ -25,6 +25,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.names import name_problem
+from gymfg_il.sim.properties import BY_NAME, DEFAULT_OPPONENT_VIEW
 from gymfg_il.viz.multiplayer import (
     FG_D2R,
     HEADER,
@@ -109,17 +111,27 @@ class Peer:
 
 def geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
     """WGS84 latitude, longitude (degrees) and altitude (ft) of an ECEF position (m), with
-    FlightGear's degree constant (``multiplayer.FG_D2R``)."""
+    FlightGear's degree constant (``multiplayer.FG_D2R``).
+
+    Defined everywhere, the polar axis and the Earth's centre included: the latitude iterates
+    ``tan(lat) = (z + e2 N sin(lat)) / p`` and the altitude is ``p cos(lat) + z sin(lat) -
+    a sqrt(1 - e2 sin(lat)^2)``, neither of which divides (on the axis, ``p = 0``, the
+    latitude is exactly +-90 and the altitude ``|z| - b``). The latitude's error shrinks by
+    ~e2 (1/150) an iteration; six leave well under a micrometre above the Earth's surface.
+    """
     lon = math.atan2(y, x)
     p = math.hypot(x, y)
     lat = math.atan2(z, p * (1.0 - _E2))
-    h = 0.0
-    for _ in range(6):  # converges to well under a millimetre at aircraft altitudes
+    for _ in range(6):
         s = math.sin(lat)
-        n = _A / math.sqrt(1.0 - _E2 * s * s)
-        h = p / math.cos(lat) - n
-        lat = math.atan2(z, p * (1.0 - _E2 * n / (n + h)))
-    return lat * _FG_R2D, lon * _FG_R2D, h / _FT
+        lat = math.atan2(z + _E2 * _A / math.sqrt(1.0 - _E2 * s * s) * s, p)
+    s = math.sin(lat)
+    h = p * math.cos(lat) + z * s - _A * math.sqrt(1.0 - _E2 * s * s)
+    # FlightGear's degree is a float32 a little short of pi/180: keep the poles and the date
+    # line where they are
+    lat_deg = max(-90.0, min(90.0, lat * _FG_R2D))
+    lon_deg = max(-180.0, min(180.0, lon * _FG_R2D))
+    return lat_deg, lon_deg, h / _FT
 
 
 def attitude(
@@ -142,7 +154,12 @@ def attitude(
 
 
 def decode(data: bytes, heard_at: float = 0.0) -> Peer:
-    """One position message as a ``Peer``; anything else raises ``MessageError``."""
+    """One position message as a ``Peer``; anything else raises ``MessageError``: a datagram
+    too short, of another kind or with non-finite numbers, a callsign that is not a printable
+    name (``names.name_problem``) or a model path that is not printable, and a pose outside
+    the bounds our own aircraft's state declares (``sim.properties``: e.g. an altitude of
+    -2000..100000 ft), so that an opponent row or a reward aimed at a FlightGear aircraft
+    sees only what an aircraft can be."""
     if len(data) < _MIN_SIZE:
         raise MessageError(f"{len(data)} bytes: shorter than a position message")
     magic, _version, kind, length, _range, _reply, raw_callsign = HEADER.unpack_from(data)
@@ -155,11 +172,26 @@ def decode(data: bytes, heard_at: float = 0.0) -> Peer:
     model, time_s, _lag, x, y, z, ox, oy, oz, vx, vy, vz = _BODY_HEAD.unpack_from(data, HEADER.size)
     if not all(math.isfinite(v) for v in (time_s, x, y, z, ox, oy, oz, vx, vy, vz)):
         raise MessageError("a position message with a non-finite position, angle or velocity")
+    callsign, model_path = _text(raw_callsign), _text(model)
+    problem = name_problem(callsign, "callsign")
+    if problem:
+        raise MessageError(problem)
+    if not model_path.isprintable():  # a path, up to 95 characters: longer than a name
+        raise MessageError(f"model {model_path!r} holds characters that are not printable")
     lat, lon, alt = geodetic(x, y, z)
     roll, pitch, heading = attitude((ox, oy, oz), lat, lon)
+    for name, value in zip(
+        DEFAULT_OPPONENT_VIEW, (lat, lon, alt, roll, pitch, heading), strict=True
+    ):
+        var = BY_NAME[name]
+        if not var.low <= value <= var.high:  # NaN too
+            raise MessageError(
+                f"{name}={value:g} {var.unit} from ECEF ({x:g}, {y:g}, {z:g}) m is outside "
+                f"{var.low:g}..{var.high:g}: not where an aircraft flies"
+            )
     return Peer(
-        callsign=_text(raw_callsign),
-        model=_text(model),
+        callsign=callsign,
+        model=model_path,
         time_s=time_s,
         lat_deg=lat,
         lon_deg=lon,
@@ -225,6 +257,8 @@ class MultiplayerLink:
 
     ``poll()`` drains what arrived without blocking and returns the aircraft heard within
     ``timeout_s`` (by callsign); call it once per step. ``clock`` is injectable for tests.
+    Nothing that arrives raises out of ``poll``: a datagram that fails to decode, for any
+    reason, is dropped and counted in ``rejected``.
     """
 
     def __init__(
@@ -245,6 +279,7 @@ class MultiplayerLink:
         self.sock.setblocking(False)
         self.peers: dict[str, Peer] = {}
         self.received = self.rejected = self.sent = 0
+        self.broken = 0  # rejected ones that raised something else than MessageError
         log.info(
             "multiplayer: listening on %s:%d, sending to %s",
             config.host,
@@ -263,8 +298,14 @@ class MultiplayerLink:
                 continue
             try:
                 peer = decode(data, now)
-            except MessageError:
-                self.rejected += 1
+            except MessageError as err:
+                self._reject(err)
+                continue
+            except Exception as err:  # a decoding bug: the datagram goes, the run goes on
+                if not self.broken:
+                    log.warning("multiplayer: a datagram broke the decoder (%r): rejected", err)
+                self.broken += 1
+                self._reject(err)
                 continue
             self.received += 1
             self.peers[peer.callsign] = peer
@@ -273,6 +314,10 @@ class MultiplayerLink:
             log.info("multiplayer: %s silent for %.1f s, dropped", callsign, self.config.timeout_s)
             del self.peers[callsign]
         return self.peers
+
+    def _reject(self, err: Exception) -> None:
+        self.rejected += 1
+        log.debug("multiplayer: datagram %d rejected: %s", self.rejected, err)
 
     def send(self, callsign: str, model: str, pose: Sequence[float]) -> None:
         """Send one of our aircraft (``pose`` as in ``Peer.pose``) to every ``send_to``."""

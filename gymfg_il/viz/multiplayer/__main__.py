@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 import time
 from collections.abc import Sequence
+from typing import TextIO
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.viz.peers import MultiplayerConfig, MultiplayerLink
@@ -43,40 +45,53 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--seconds", type=float, default=10.0, help="how long to listen (default 10)")
     p.add_argument("--json", metavar="OUT", help="also write the lines to this file")
     args = top.parse_args(argv)
+    if not args.seconds > 0:  # NaN too
+        print(f"error: --seconds {args.seconds:g}: listen for a positive time", file=sys.stderr)
+        return 2
     try:
         link = MultiplayerLink(MultiplayerConfig(listen_port=args.port, host=args.host))
     except ConfigError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    out = open(args.json, "w") if args.json else None  # noqa: SIM115 (closed below)
     heard: set[str] = set()
     try:
-        end = time.monotonic() + args.seconds
-        next_print = time.monotonic() + 1.0
-        while time.monotonic() < end:
-            time.sleep(0.02)
-            peers = link.poll()
-            if time.monotonic() < next_print:
-                continue
-            next_print += 1.0
-            for peer in sorted(peers.values(), key=lambda p: p.callsign):
-                heard.add(peer.callsign)
-                line = json.dumps(peer.summary())
-                print(line, flush=True)
-                if out:
-                    out.write(line + "\n")
-                    out.flush()
+        with contextlib.ExitStack() as files:
+            out = files.enter_context(open(args.json, "w")) if args.json else None
+            _listen(link, args.seconds, out, heard)
+    except OSError as err:  # opening or writing --json (stdout is not a file of ours)
+        print(f"error: --json {args.json}: cannot write there ({err})", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:  # ctrl-C ends the listening, as --seconds would
+        pass
     finally:
         link.close()
-        if out:
-            out.close()
     if not heard:
         print(
             f"heard nobody on {args.host}:{args.port} in {args.seconds:g} s "
-            f"({link.rejected} datagrams that were not position messages)",
+            f"({link.rejected} datagrams rejected: not a position message, or not an aircraft)",
             file=sys.stderr,
         )
     return 0
+
+
+def _listen(link: MultiplayerLink, seconds: float, out: TextIO | None, heard: set[str]) -> None:
+    """Print the aircraft heard about once a second for ``seconds`` (and write them to
+    ``out``); the callsigns go into ``heard``."""
+    end = time.monotonic() + seconds
+    next_print = time.monotonic() + 1.0
+    while time.monotonic() < end:
+        time.sleep(0.02)
+        peers = link.poll()
+        if time.monotonic() < next_print:
+            continue
+        next_print += 1.0
+        for peer in sorted(peers.values(), key=lambda p: p.callsign):
+            heard.add(peer.callsign)
+            line = json.dumps(peer.summary())
+            print(line, flush=True)
+            if out:
+                out.write(line + "\n")
+                out.flush()
 
 
 if __name__ == "__main__":
