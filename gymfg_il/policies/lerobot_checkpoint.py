@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.policies.lerobot_allowed import check_checkpoint
 from gymfg_il.sim.properties import task_columns
 
 STATE, ENVIRONMENT, IMAGES = (
@@ -78,6 +79,7 @@ class LeRobotAgent:
     the current state (``AgentSpec.make`` wires the env's camera)."""
 
     def __init__(self, folder: Path, device: str = "cpu") -> None:
+        check_checkpoint(folder)  # before LeRobot imports or calls anything the files name
         import torch
         from lerobot.configs.policies import PreTrainedConfig
         from lerobot.policies.factory import get_policy_class, make_pre_post_processors
