@@ -40,7 +40,7 @@ from mcap.summary import Summary
 from mcap.writer import CompressionType, IndexType, Writer
 
 from gymfg_il.recording.mcap_walk import MAGIC, MESSAGE
-from gymfg_il.recording.reader import LogError
+from gymfg_il.recording.reader import LogError, read_log
 
 _FOOTER = 1 + 8 + 20 + len(MAGIC)  # footer record (opcode, length, body) and closing magic
 _SUMMARY_OFFSET, _ATTACHMENT_INDEX = 0x0E, 0x0A
@@ -180,11 +180,18 @@ class Reindexed:
 def reindex(path: Path, chunk_size: int = 256 * 1024) -> Reindexed:
     """Give the finished log at ``path`` message indexes (and no empty attachment index), in
     place and crash-safely (see the module docstring). A log that has them is left untouched;
-    a damaged or unfinished one raises LogError and is left as it was."""
+    a damaged (any CRC it carries fails) or unfinished one raises LogError and is left as it
+    was."""
     path = Path(path)
     if not path.is_file():
         raise LogError(f"no log at {path}")
     problems = index_problems(path)
+    damage = read_log(path).damage  # every chunk's CRC, the session record's, the data's
+    if damage:
+        raise LogError(
+            f"{path} is damaged and was left as it was: {'; '.join(damage)} "
+            "(`python -m gymfg_il.collect recover` keeps what can be read)"
+        )
     size = path.stat().st_size
     if not problems:
         return Reindexed(path, False, 0, (), size, size)
@@ -216,7 +223,11 @@ def _rewrite(path: Path, tmp: Path, chunk_size: int) -> tuple[int, str]:
         count, digest = 0, hashlib.blake2b()
         with open(tmp, "xb") as out:
             writer = Writer(
-                out, chunk_size=chunk_size, compression=CompressionType.ZSTD, index_types=indexes
+                out,
+                chunk_size=chunk_size,
+                compression=CompressionType.ZSTD,
+                index_types=indexes,
+                enable_data_crcs=True,
             )
             try:
                 for record in StreamReader(f, validate_crcs=True).records:

@@ -3,9 +3,11 @@
 Chunks decode independently: a chunk that fails to decompress or fails its CRC is skipped and
 reported, and the walk goes on with the next record. A record whose header is garbage (a bad
 opcode or a length that cannot be) is skipped by searching forward for the next record that
-parses as a whole chunk. A record cut off by the end of the file is where a killed session
-stopped writing (not damage), unless a whole chunk follows it. The mcap library's readers stop
-at the first bad byte; this one keeps every episode the damage does not reach.
+parses as a whole chunk or a whole metadata record. A record cut off by the end of the file is
+where a killed session stopped writing (not damage), unless a whole record follows it. The mcap
+library's readers stop at the first bad byte; this one keeps every episode the damage does not
+reach. ``summary_intact`` and ``data_intact`` check the CRCs a finished file carries of its
+summary and of everything before it.
 
 Layout (little endian): magic, then records of ``opcode u8, length u64, body``; a chunk body
 is ``start u64, end u64, uncompressed_size u64, uncompressed_crc u32, compression (u32 length
@@ -24,6 +26,7 @@ import zstandard
 MAGIC = b"\x89MCAP0\r\n"
 HEADER, FOOTER, SCHEMA, CHANNEL, MESSAGE, CHUNK = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06
 METADATA, DATA_END = 0x0C, 0x0F
+_FOOTER_HEAD = struct.Struct("<BQQQ")  # opcode, length, summary start, summary offset start
 KNOWN = set(range(0x01, 0x10))
 _RECORD = struct.Struct("<BQ")
 _CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
@@ -62,14 +65,32 @@ def _chunk_at(data: bytes, pos: int) -> int | None:
     return end if head + clen + 8 + records == end else None
 
 
-def _next_chunk(data: bytes, start: int) -> int | None:
-    """The offset of the next whole chunk record at or after ``start``."""
-    pos = data.find(bytes([CHUNK]), start)
-    while pos != -1:
-        if _chunk_at(data, pos) is not None:
-            return pos
-        pos = data.find(bytes([CHUNK]), pos + 1)
-    return None
+def _metadata_at(data: bytes, pos: int) -> bool:
+    """Whether a whole metadata record (a name, then a string map filling the body) is at
+    ``pos``."""
+    if pos + 9 + 8 > len(data) or data[pos] != METADATA:
+        return False
+    (length,) = _U64.unpack_from(data, pos + 1)
+    end = pos + 9 + length
+    if end > len(data) or length > _MAX_CHUNK:
+        return False
+    at = pos + 9 + 4 + _U32.unpack_from(data, pos + 9)[0]
+    if at + 4 > end:
+        return False
+    return at + 4 + _U32.unpack_from(data, at)[0] == end
+
+
+def _next_record(data: bytes, start: int) -> int | None:
+    """The offset of the next whole chunk or metadata record at or after ``start``."""
+    found = []
+    for opcode in (CHUNK, METADATA):
+        pos = data.find(bytes([opcode]), start)
+        while pos != -1:
+            if _chunk_at(data, pos) is not None or _metadata_at(data, pos):
+                found.append(pos)
+                break
+            pos = data.find(bytes([opcode]), pos + 1)
+    return min(found, default=None)
 
 
 def records(data: bytes, damage: list[Damage]) -> Iterator[tuple[int, int, memoryview]]:
@@ -81,13 +102,14 @@ def records(data: bytes, damage: list[Damage]) -> Iterator[tuple[int, int, memor
         opcode, length = _RECORD.unpack_from(data, pos)
         end = pos + 9 + length
         sane = opcode in KNOWN and length <= len(data)
-        if sane and end <= len(data) and (opcode != CHUNK or _chunk_at(data, pos) is not None):
+        whole = opcode != CHUNK or _chunk_at(data, pos) is not None
+        if sane and end <= len(data) and whole:
             yield pos, opcode, view[pos + 9 : end]
             if opcode == FOOTER:
                 return
             pos = end
             continue
-        resume = _next_chunk(data, pos + 1)
+        resume = _next_record(data, pos + 1)
         if resume is None:
             if sane:
                 return  # cut off by the end of the file: where the writer was killed
@@ -95,6 +117,36 @@ def records(data: bytes, damage: list[Damage]) -> Iterator[tuple[int, int, memor
             return
         damage.append(Damage(pos, resume, f"a damaged record (opcode {opcode:#04x})"))
         pos = resume
+
+
+def magic_damage(data: bytes) -> Damage | None:
+    """What is wrong with the file's opening magic: None when intact (or cut short inside
+    it), a Damage when one byte differs; ValueError when it is not an MCAP file."""
+    head = data[: len(MAGIC)]
+    if MAGIC.startswith(head):
+        return None
+    if len(head) == len(MAGIC) and sum(a != b for a, b in zip(head, MAGIC, strict=True)) == 1:
+        return Damage(0, len(MAGIC), "the MCAP magic is damaged")
+    raise ValueError("not an MCAP file")
+
+
+def summary_intact(data: bytes, footer: int, body: memoryview) -> bool | None:
+    """Whether the summary section passes the CRC in the footer record at ``footer``
+    (None: the file records no CRC)."""
+    start, offsets, crc = struct.unpack_from("<QQI", body, 0)
+    if not crc:
+        return None
+    if not 0 < start <= footer:
+        return False
+    head = _FOOTER_HEAD.pack(FOOTER, len(body), start, offsets)
+    return zlib.crc32(head, zlib.crc32(data[start:footer])) == crc
+
+
+def data_intact(data: bytes, data_end: int, body: memoryview) -> bool | None:
+    """Whether everything before the data end record at ``data_end`` passes the CRC it
+    carries (None: the file records none)."""
+    (crc,) = _U32.unpack_from(body, 0)
+    return None if not crc else zlib.crc32(data[:data_end]) == crc
 
 
 def chunk_data(body: memoryview) -> bytes:

@@ -1,6 +1,11 @@
 """Sorting a log's messages by kind as they stream past: episode events, each aircraft's step
 rows and full states, each team's opponent views (only what a dataset needs is decoded; full
-states and views stay bytes until asked for)."""
+states and views stay bytes until asked for).
+
+The channel records sit in the first chunk; the writer keeps a copy of them outside every
+chunk (the ``gymfg.channels`` metadata record) and a finished file another in its summary, so
+a damaged first chunk costs only its own episodes. The session record is written twice, each
+copy with its CRC (``recording.session.checked``)."""
 
 from __future__ import annotations
 
@@ -13,16 +18,25 @@ import orjson
 from gymfg_il.recording.mcap_walk import (
     CHANNEL,
     CHUNK,
+    DATA_END,
     FOOTER,
     MESSAGE,
     METADATA,
     Damage,
     chunk_data,
+    data_intact,
     records,
     string,
     string_map,
+    summary_intact,
 )
-from gymfg_il.recording.session import SESSION_METADATA
+from gymfg_il.recording.session import (
+    CHANNELS_METADATA,
+    CRC_KEY,
+    SESSION_COPY,
+    SESSION_METADATA,
+    crc_state,
+)
 from gymfg_il.recording.writer import EPISODE_TOPIC
 
 _U16 = struct.Struct("<H")
@@ -70,6 +84,7 @@ class Sorter:
             self.channel(channel_id, topic)
 
     def channel(self, channel_id: int, topic: str) -> None:
+        self.kinds.pop(channel_id, None)  # a chunk's record overrides a copy's
         if topic == EPISODE_TOPIC:
             self.kinds[channel_id] = ("episode", "")
             return
@@ -105,24 +120,74 @@ class Sorter:
 def stream(data: bytes, seen: Sorter, damage: list[Damage]) -> tuple[dict[str, Any] | None, bool]:
     """Feed a log's records to ``seen``; (session record, finished?). Damaged chunks and
     records are skipped and described in ``damage``."""
-    session: dict[str, Any] | None = None
-    finished = False
-    for pos, opcode, body in records(data, damage):
+    found = list(records(data, damage))
+    maps: list[tuple[int, int, str, dict[str, str]]] = []  # (offset, end, name, entries)
+    finished, summary_ok, data_ok, data_end = False, None, None, len(data)
+    for pos, opcode, body in found:
         end = pos + 9 + len(body)
+        if opcode == METADATA:
+            try:
+                name, at = string(body, 0)
+                maps.append((pos, end, name, string_map(body, at)))
+            except (ValueError, struct.error) as err:
+                damage.append(Damage(pos, end, f"a damaged metadata record ({err})"))
+        elif opcode == DATA_END:
+            data_ok, data_end = data_intact(data, pos, body), pos
+        elif opcode == FOOTER:
+            finished, summary_ok = True, summary_intact(data, pos, body)
+    session = _session(maps, damage)
+    # channels the first chunk declares, should it be lost: the summary's (unless its CRC
+    # fails) over the writer's table
+    for pos, end, name, entries in maps:
+        if name == CHANNELS_METADATA:
+            if crc_state(entries) is False:
+                damage.append(Damage(pos, end, "the channel table fails its CRC check"))
+                continue
+            for key, topic in entries.items():
+                if key != CRC_KEY and key.isdigit():
+                    seen.channel(int(key), topic)
+    if summary_ok is False:
+        damage.append(Damage(data_end, len(data), "the summary fails its CRC check"))
+    for pos, opcode, body in found:
+        if opcode == CHANNEL and (pos < data_end or summary_ok is not False):
+            seen.record(opcode, body)
+    for pos, opcode, body in found:
+        if pos >= data_end:
+            break
         if opcode == CHUNK:
             try:
                 seen.chunk(chunk_data(body))
             except (ValueError, struct.error) as err:
-                damage.append(Damage(pos, end, str(err)))
+                damage.append(Damage(pos, pos + 9 + len(body), str(err)))
         elif opcode in (CHANNEL, MESSAGE):
             seen.record(opcode, body)
-        elif opcode == METADATA:
-            try:
-                name, at = string(body, 0)
-                if name == SESSION_METADATA:
-                    session = {k: json.loads(v) for k, v in string_map(body, at).items()}
-            except (ValueError, struct.error) as err:
-                damage.append(Damage(pos, end, f"a damaged metadata record ({err})"))
-        elif opcode == FOOTER:
-            finished = True
+    if data_ok is False and not any(d.start < data_end for d in damage):
+        damage.append(
+            Damage(
+                0,
+                data_end,
+                "the data section fails its CRC outside every chunk (a record header or "
+                "index; every chunk read passed its own CRC)",
+            )
+        )
     return session, finished
+
+
+def _session(maps: list[tuple[int, int, str, dict[str, str]]], damage: list[Damage]) -> Any:
+    """The session record: the first copy that passes its CRC (logs before the CRC: the
+    first that decodes); damaged copies go to ``damage``."""
+    chosen = None
+    for pos, end, name, entries in maps:
+        if name not in (SESSION_METADATA, SESSION_COPY):
+            continue
+        state = crc_state(entries)
+        try:
+            record = {k: json.loads(v) for k, v in entries.items() if k != CRC_KEY}
+        except ValueError as err:
+            damage.append(Damage(pos, end, f"a damaged session record ({err})"))
+            continue
+        if state is False:
+            damage.append(Damage(pos, end, "a session record fails its CRC check"))
+        elif chosen is None:
+            chosen = record
+    return chosen

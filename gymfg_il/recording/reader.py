@@ -4,6 +4,8 @@ or not (a bad chunk costs the episodes it held, and ``Log.damage`` says which an
 from __future__ import annotations
 
 import gc
+import os
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -13,7 +15,7 @@ import orjson
 
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import GymFGError
-from gymfg_il.recording.mcap_walk import MAGIC, Damage
+from gymfg_il.recording.mcap_walk import Damage, magic_damage
 from gymfg_il.recording.messages import Sorter, stream
 from gymfg_il.recording.session import spec_of, upgrade
 from gymfg_il.rollout.records import OpponentView
@@ -150,18 +152,45 @@ def _steps(rows: list[dict[str, Any]], states: list[Any]) -> AircraftSteps:
     )
 
 
+def read_bytes(path: Path) -> bytes:
+    """The bytes of the regular file at ``path``; LogError for anything else (a FIFO, whose
+    open would block, a device such as /dev/zero, which never ends, a folder)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except FileNotFoundError:
+        raise LogError(f"no trajectory log at {path}") from None
+    except OSError as err:
+        raise LogError(f"{path} cannot be opened ({err.strerror})") from None
+    with open(fd, "rb", closefd=True) as f:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise LogError(
+                f"{path} is not a regular file (it is {_kind(mode)}); a trajectory log is one"
+            )
+        return f.read()
+
+
+def _kind(mode: int) -> str:
+    kinds = {stat.S_ISDIR: "a folder", stat.S_ISFIFO: "a FIFO", stat.S_ISCHR: "a device"}
+    kinds |= {stat.S_ISBLK: "a device", stat.S_ISSOCK: "a socket", stat.S_ISLNK: "a link"}
+    return next((what for test, what in kinds.items() if test(mode)), "not a file")
+
+
 def read_log(path: Path) -> Log:
     """Everything readable in ``path``: an unfinished file yields its durable part, a
     damaged one every episode the damage does not touch (``Log.damage`` says what was lost
     and why)."""
     path = Path(path)
-    if not path.is_file():
-        raise LogError(f"no trajectory log at {path}")
-    data = path.read_bytes()
-    if not data.startswith(MAGIC[: len(data)]) or (len(data) >= len(MAGIC) and data[:8] != MAGIC):
-        raise LogError(f"{path} is not a readable GymFG trajectory log (not an MCAP file)")
+    data = read_bytes(path)
     seen = Sorter()
     damage: list[Damage] = []
+    try:
+        bad_magic = magic_damage(data)
+    except ValueError:
+        raise LogError(
+            f"{path} is not a readable GymFG trajectory log (not an MCAP file)"
+        ) from None
+    damage += [bad_magic] if bad_magic else []
     # Tens of thousands of small decoded messages would trigger the cyclic GC many times
     # over; none of them form cycles.
     gc_was_enabled = gc.isenabled()
@@ -172,7 +201,7 @@ def read_log(path: Path) -> Log:
         if gc_was_enabled:
             gc.enable()
     if session is None:
-        if not seen.events:
+        if not seen.events and not damage:
             raise EmptyLog(
                 f"{path} holds no session record and no episode (a session stopped before "
                 "its first write); nothing in it to keep"
@@ -182,7 +211,7 @@ def read_log(path: Path) -> Log:
             f"({'; '.join(map(str, damage)) or 'none was written'})"
         )
     episodes = _episodes(seen)
-    notes = [str(d) for d in damage] + _lost(episodes)
+    notes = [str(d) for d in damage] + _lost(episodes, seen)
     return Log(path, upgrade(session), episodes, finished, notes)
 
 
@@ -205,9 +234,10 @@ def _episodes(seen: Sorter) -> list[LoggedEpisode]:
     return [episodes[k] for k in sorted(episodes)]
 
 
-def _lost(episodes: list[LoggedEpisode]) -> list[str]:
-    """Episodes that damage took: ended but missing steps, or never ended although later
-    episodes began (the last one unended is where a session stopped, not damage)."""
+def _lost(episodes: list[LoggedEpisode], seen: Sorter) -> list[str]:
+    """Episodes that damage took: ended but missing steps, never ended although later
+    episodes began (the last one unended is where a session stopped, not damage), or whose
+    start was lost (steps without one, or a number skipped before the last episode)."""
     notes = []
     for i, ep in enumerate(episodes):
         if ep.discarded:
@@ -216,4 +246,9 @@ def _lost(episodes: list[LoggedEpisode]) -> list[str]:
             notes.append(f"episode {ep.index}: {ep.gaps()}; left out")
         elif ep.end is None and i < len(episodes) - 1:
             notes.append(f"episode {ep.index}: its end was lost; left out")
+    started = {ep.index for ep in episodes}
+    known = started | {k for k, _ in seen.rows} | {int(e.get("episode", -1)) for e in seen.events}
+    for k in range(max(known, default=-1) + 1):
+        if k not in started:
+            notes.append(f"episode {k}: its start was lost; left out")
     return notes

@@ -11,6 +11,8 @@ Logs written before the flight spec existed (``schema_version`` 1) are read as i
 
 from __future__ import annotations
 
+import json
+import zlib
 from collections.abc import Mapping
 from typing import Any
 
@@ -21,6 +23,26 @@ from gymfg_il.tasks.base import Task
 
 SCHEMA_VERSION = 2
 SESSION_METADATA = "gymfg.session"
+SESSION_COPY = "gymfg.session.copy"  # the same record again: a flipped bit costs one of two
+CHANNELS_METADATA = "gymfg.channels"  # channel id -> topic, outside every chunk
+CRC_KEY = "gymfg.crc32"
+
+
+def _crc(entries: Mapping[str, str]) -> str:
+    body = sorted((k, v) for k, v in entries.items() if k != CRC_KEY)
+    return str(zlib.crc32(json.dumps(body).encode()))
+
+
+def checked(entries: Mapping[str, str]) -> dict[str, str]:
+    """A metadata map with its CRC-32 under ``CRC_KEY`` (MCAP checks no metadata record)."""
+    return {**entries, CRC_KEY: _crc(entries)}
+
+
+def crc_state(entries: Mapping[str, str]) -> bool | None:
+    """Whether a metadata map passes its CRC; None when it has none (logs before it)."""
+    if CRC_KEY not in entries:
+        return None
+    return entries[CRC_KEY] == _crc(entries)
 
 
 def package_versions() -> dict[str, str]:

@@ -25,7 +25,7 @@ from mcap.writer import CompressionType, IndexType, Writer
 
 from gymfg_il.recording import foxglove as fg
 from gymfg_il.recording import schemas
-from gymfg_il.recording.session import SESSION_METADATA
+from gymfg_il.recording.session import CHANNELS_METADATA, SESSION_COPY, SESSION_METADATA, checked
 from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
 from gymfg_il.sim.properties import ACTION_NAMES, INDEX, NAMES
 from gymfg_il.tasks.scenery import task_landmarks
@@ -110,6 +110,7 @@ class TrajectoryWriter:
             chunk_size=chunk_size,
             compression=CompressionType.ZSTD,
             index_types=IndexType.CHUNK | IndexType.MESSAGE | IndexType.METADATA,
+            enable_data_crcs=True,  # a flip outside every chunk is found too
         )
         w.start(profile="", library="gymfg-il")
 
@@ -129,12 +130,18 @@ class TrajectoryWriter:
             schema("foxglove.FrameTransform", fg.schema("foxglove.FrameTransform")),
             schema("foxglove.SceneUpdate", fg.schema("foxglove.SceneUpdate")),
         )
-        self._events = w.register_channel(EPISODE_TOPIC, "json", event)
-        self._steps = {c: w.register_channel(step_topic(c), "json", step) for c in callsigns}
-        self._states = {c: w.register_channel(state_topic(c), "json", state) for c in callsigns}
-        self._fixes = {c: w.register_channel(location_topic(c), "json", fix) for c in callsigns}
-        self._tfs = {c: w.register_channel(transform_topic(c), "json", tf) for c in callsigns}
-        self._scenes = {c: w.register_channel(scene_topic(c), "json", scene) for c in callsigns}
+        topics: dict[int, str] = {}
+
+        def channel(topic: str, schema_id: int) -> int:
+            topics[channel_id := w.register_channel(topic, "json", schema_id)] = topic
+            return channel_id
+
+        self._events = channel(EPISODE_TOPIC, event)
+        self._steps = {c: channel(step_topic(c), step) for c in callsigns}
+        self._states = {c: channel(state_topic(c), state) for c in callsigns}
+        self._fixes = {c: channel(location_topic(c), fix) for c in callsigns}
+        self._tfs = {c: channel(transform_topic(c), tf) for c in callsigns}
+        self._scenes = {c: channel(scene_topic(c), scene) for c in callsigns}
         self._look = {
             c: (a.get("model", ""), teams.index(a["team"])) for c, a in session["aircraft"].items()
         }
@@ -142,11 +149,16 @@ class TrajectoryWriter:
         self._aims: dict[str, fg.Aim] = {}
         self._leads: dict[str, tuple[str, dict[str, Any]]] = {}  # callsign -> (task, plan)
         self._views = (
-            {t: w.register_channel(view_topic(t), "json", view) for t in teams}
+            {t: channel(view_topic(t), view) for t in teams}
             if len(teams) > 1 or session.get("online")
             else {}
         )
-        w.add_metadata(SESSION_METADATA, {k: json.dumps(v) for k, v in session.items()})
+        # Outside every chunk, each with its CRC: the session record twice and the channel
+        # table, so that one damaged chunk or record never costs the whole log
+        record = checked({k: json.dumps(v) for k, v in session.items()})
+        w.add_metadata(SESSION_METADATA, record)
+        w.add_metadata(SESSION_COPY, record)
+        w.add_metadata(CHANNELS_METADATA, checked({str(c): t for c, t in topics.items()}))
         self._dt_ns = round(float(session["dt"]) * 1e9)
         self._clock_ns = time.time_ns()
         self._base_ns = self._clock_ns  # the log time of the current episode's reset

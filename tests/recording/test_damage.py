@@ -100,3 +100,92 @@ def test_a_dataset_with_a_truncated_data_file_is_rebuilt(session, tmp_path, caps
     assert not list(copy.glob("dataset.building-*")) and not list(copy.glob("dataset.old-*"))
     report = build_from_logs([path], copy / "dataset")
     assert report.added == 0 and report.total_episodes == 4
+
+
+def _chunks(data):
+    """(offset, end) of every chunk record of an intact log."""
+    from gymfg_il.recording.mcap_walk import CHUNK, records
+
+    return [(pos, pos + 9 + len(body)) for pos, op, body in records(data, []) if op == CHUNK]
+
+
+def _episodes_in(data, start, end):
+    """The episodes whose step messages the chunk at ``start`` holds (read intact)."""
+    from gymfg_il.recording.mcap_walk import chunk_data, records
+    from gymfg_il.recording.messages import Sorter
+
+    seen = Sorter()
+    for pos, _, body in records(data, []):
+        if pos == start:
+            # the channel records are in the first chunk: learn them, then sort this one
+            seen.chunk(chunk_data(next(b for p, o, b in records(data, []) if o == 0x06)))
+            seen.rows.clear()
+            seen.chunk(chunk_data(body))
+    return {k for k, _ in seen.rows}
+
+
+@pytest.mark.parametrize("finished", [True, False], ids=["finished", "killed"])
+def test_a_bit_in_the_first_chunk_costs_only_the_episodes_it_holds(
+    session, tmp_path, capsys, finished
+):
+    """Red team #32.9: one flipped bit in the first chunk (which holds the channel records)
+    lost every episode; now it costs the episodes that chunk holds, and the report names
+    them. A killed session's log (no summary) keeps the rest too."""
+    _, path = session
+    data = path.read_bytes()
+    first, end = _chunks(data)[0]
+    touched = _episodes_in(data, first, end)
+    if not finished:  # as a kill -9 leaves it: no summary, no footer
+        data = data[: _chunks(data)[-1][1]]
+    bad = bytearray(data)
+    bad[(first + end) // 2] ^= 0x10  # inside the compressed records
+    folder = tmp_path / "s"
+    (folder / "logs").mkdir(parents=True)
+    (folder / "logs" / path.name).write_bytes(bytes(bad))
+    log = read_log(folder / "logs" / path.name)
+    kept = {e.index for e in log.complete_episodes}
+    assert touched and kept == {0, 1, 2, 3} - touched
+    assert collect.main(["recover", str(folder)]) == 1
+    err = capsys.readouterr().err
+    assert "fails its CRC check" in err
+    for k in sorted(touched):
+        assert f"episode {k}" in err
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    assert LeRobotDataset("x/y", root=folder / "dataset").num_episodes == len(kept)
+
+
+def test_reindex_refuses_a_damaged_log_it_used_to_call_fine(session, tmp_path, capsys):
+    """Red team #32.9: `collect reindex` said "already has message indexes" of a log with a
+    damaged chunk, and exited 0; a flip outside every chunk is found too (the data CRC)."""
+    _, path = session
+    data = path.read_bytes()
+    chunks = _chunks(data)
+    for offset in ((chunks[0][0] + chunks[0][1]) // 2, chunks[0][1] + 12):
+        bad = bytearray(data)
+        bad[offset] ^= 0x01
+        target = tmp_path / f"at-{offset}.mcap"
+        target.write_bytes(bytes(bad))
+        assert collect.main(["reindex", str(target)]) == 1
+        out, err = capsys.readouterr()
+        assert "already has message indexes" not in out
+        assert f"refused {target}" in err and "damaged" in err
+        assert target.read_bytes() == bytes(bad)  # left as it was
+
+
+def test_no_single_flipped_byte_in_the_log_head_loses_the_whole_log(session, tmp_path):
+    """Red team #32.9: the bytes before the first chunk's records (the magic, the header, the
+    session record and its copy, the channel table) and the first chunk's record header:
+    a flip in any of them costs at most the first chunk's episodes."""
+    _, path = session
+    data = path.read_bytes()
+    first, end = _chunks(data)[0]
+    spared = {0, 1, 2, 3} - _episodes_in(data, first, end)
+    head = range(0, first + 9 + 40, 7)
+    broken = tmp_path / "broken.mcap"
+    for offset in head:
+        bad = bytearray(data)
+        bad[offset] ^= 0x04
+        broken.write_bytes(bytes(bad))
+        log = read_log(broken)  # never "the session record is lost"
+        assert {e.index for e in log.complete_episodes} >= spared, offset
