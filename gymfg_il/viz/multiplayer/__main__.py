@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import signal
 import sys
+import threading
 import time
 from collections.abc import Sequence
 from typing import TextIO
@@ -42,7 +44,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         default="127.0.0.1",
         help="address to bind (default 127.0.0.1, this machine only; 0.0.0.0 for all)",
     )
-    p.add_argument("--seconds", type=float, default=10.0, help="how long to listen (default 10)")
+    p.add_argument(
+        "--seconds",
+        type=float,
+        default=10.0,
+        help="how long to listen (default 10; ctrl-C stops sooner)",
+    )
     p.add_argument("--json", metavar="OUT", help="also write the lines to this file")
     args = top.parse_args(argv)
     if not args.seconds > 0:  # NaN too
@@ -54,15 +61,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"error: {err}", file=sys.stderr)
         return 2
     heard: set[str] = set()
+    stop = threading.Event()
     try:
         with contextlib.ExitStack() as files:
+            if threading.current_thread() is threading.main_thread():
+                # ctrl-C ends the listening between two polls, as --seconds would
+                previous = signal.signal(signal.SIGINT, lambda *_: stop.set())
+                files.callback(signal.signal, signal.SIGINT, previous)
             out = files.enter_context(open(args.json, "w")) if args.json else None
-            _listen(link, args.seconds, out, heard)
+            _listen(link, args.seconds, out, heard, stop)
     except OSError as err:  # opening or writing --json (stdout is not a file of ours)
         print(f"error: --json {args.json}: cannot write there ({err})", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:  # ctrl-C ends the listening, as --seconds would
-        pass
     finally:
         link.close()
     if not heard:
@@ -74,12 +84,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
-def _listen(link: MultiplayerLink, seconds: float, out: TextIO | None, heard: set[str]) -> None:
-    """Print the aircraft heard about once a second for ``seconds`` (and write them to
-    ``out``); the callsigns go into ``heard``."""
+def _listen(
+    link: MultiplayerLink,
+    seconds: float,
+    out: TextIO | None,
+    heard: set[str],
+    stop: threading.Event,
+) -> None:
+    """Print the aircraft heard about once a second for ``seconds`` or until ``stop`` (and
+    write them to ``out``); the callsigns go into ``heard``."""
     end = time.monotonic() + seconds
     next_print = time.monotonic() + 1.0
-    while time.monotonic() < end:
+    while time.monotonic() < end and not stop.is_set():
         time.sleep(0.02)
         peers = link.poll()
         if time.monotonic() < next_print:
