@@ -10,6 +10,9 @@ each base episode with the log it came from. A rebuild takes from a linked log o
 episodes listed there (the base dataset may hold fewer than its logs: one aircraft of a team
 run, or episodes deleted since), in the base dataset's order, before the session's own.
 ``unrebuildable`` names the episodes a dataset should hold that its logs cannot give.
+
+A log name read from a dataset or ``base-episodes.json`` becomes a path only through
+``log_path``: a plain file name inside the folder (no separator, not ``..``), or refused.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import json
 import logging
 import os
 import shutil
+import stat
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +32,25 @@ from gymfg_il.errors import ConfigError
 
 BASE_EPISODES = "base-episodes.json"
 log = logging.getLogger(__name__)
+_NAME_MAX = 255  # a file name's length on common file systems
+
+
+def log_name_problem(name: object) -> str | None:
+    """Why ``name`` (read from a dataset or a record) is not a log's file name, or None."""
+    rule = "a log is named by its file name alone, inside the session's logs/ folder"
+    if not isinstance(name, str) or not 0 < len(name) <= _NAME_MAX:
+        return f"{str(name)[:80]!r} is not a log file name ({rule})"
+    if name in (".", "..") or "/" in name or "\\" in name or not name.isprintable():
+        return f"{name[:80]!r} is not a log file name ({rule})"
+    return None
+
+
+def log_path(folder: Path, name: str) -> Path:
+    """``folder / name`` for a plain file name; ConfigError (naming it) for any other."""
+    problem = log_name_problem(name)
+    if problem is not None:
+        raise ConfigError(problem)
+    return Path(folder) / name
 
 
 @dataclass(frozen=True, order=True)
@@ -90,16 +113,20 @@ def _link(source: Path, target: Path) -> None:
 def link_base_logs(base: Path, logs: Path) -> list[str]:
     """Link the logs of every episode of the dataset at ``base`` (a session's ``dataset/``:
     its logs are in the session's ``logs/``) into ``logs`` and record them in
-    ``logs/base-episodes.json``; what could not be linked, one line per episode."""
+    ``logs/base-episodes.json``; what could not be linked, one line per episode. A log name
+    that is no plain file name (``log_name_problem``) links nothing."""
     source = Path(base).parent / "logs"
     logs.mkdir(parents=True, exist_ok=True)
     problems, episodes = [], []
     for index, ref in dataset_refs(base):
         entry: dict[str, Any] = {"index": index, "log": None}
+        bad = None if ref is None else log_name_problem(ref.log)
         if ref is None:
             problems.append(f"base episode {index}: records no log")
-        elif not (source / ref.log).is_file():
-            problems.append(f"base episode {index} ({ref}): no {source / ref.log}")
+        elif bad is not None:
+            problems.append(f"base episode {index}: {bad}; not linked")
+        elif not _regular(source / ref.log):
+            problems.append(f"base episode {index} ({ref}): no log file {source / ref.log}")
             entry |= {"log": ref.log, "log_episode": ref.episode, "callsign": ref.callsign}
         else:
             _link(source / ref.log, logs / ref.log)
@@ -117,6 +144,14 @@ def link_base_logs(base: Path, logs: Path) -> list[str]:
     return problems
 
 
+def _regular(path: Path) -> bool:
+    """A regular file itself, not a link to one (a link may lead out of the folder)."""
+    try:
+        return stat.S_ISREG(path.lstat().st_mode)
+    except OSError:
+        return False
+
+
 def base_refs(folders: Iterable[Path]) -> list[tuple[int, EpisodeRef | None]]:
     """The base episodes ``base-episodes.json`` in ``folders`` name, in the base order."""
     out: list[tuple[int, EpisodeRef | None]] = []
@@ -129,6 +164,7 @@ def base_refs(folders: Iterable[Path]) -> list[tuple[int, EpisodeRef | None]]:
             for e in record["episodes"]:
                 ref = None
                 if e.get("log") is not None:
+                    log_path(path.parent, e["log"])  # a file name in this folder, or refused
                     ref = EpisodeRef(e["log"], int(e["log_episode"]), e["callsign"])
                 out.append((int(e["index"]), ref))
         except (ValueError, KeyError, TypeError) as err:
@@ -150,6 +186,8 @@ def unrebuildable(
     for index, ref in wanted:
         if ref is None:
             lines.append(f"dataset episode {index}: records no log")
+        elif log_name_problem(ref.log) is not None:
+            lines.append(f"dataset episode {index}: {log_name_problem(ref.log)}")
         elif ref not in logged:
             why = "not a completed episode of it" if (logs / ref.log).is_file() else "log missing"
             lines.append(f"dataset episode {index}: {ref}: {why}")
