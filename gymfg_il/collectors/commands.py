@@ -11,6 +11,7 @@ from pathlib import Path
 from gymfg_il.collectors.session import DATASET, LOGS
 from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs, dataset_refs, unrebuildable
 from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
+from gymfg_il.datasets.gather import set_aside
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import EmptyLog, read_log
 from gymfg_il.recording.replay import replay_episode, world_for
@@ -19,9 +20,11 @@ from gymfg_il.recording.replay import replay_episode, world_for
 @dataclass
 class RecoverConfig:
     """Rebuild a session's dataset from its logs (after a crash or kill: keeps every
-    completed episode). Every episode the dataset holds, or held, that no log under logs/
-    can rebuild (its log deleted, or a DAgger session's base episodes without their linked
-    logs) is named, and the exit status is 1.
+    completed episode). The logs are the truth: a dataset that differs from them is kept
+    beside as dataset.broken-<time> and rebuilt; a file under logs/ that is no readable log
+    is renamed <name>.set-aside. Every episode the dataset holds, or held, that no log under
+    logs/ can rebuild (its log deleted, or a DAgger session's base episodes without their
+    linked logs) is named, and the exit status is 1.
 
     Attributes:
         dir: the session folder (logs/ inside).
@@ -85,13 +88,23 @@ class ReindexConfig:
     logs: list[Path] = field(metadata={"positional": True})
 
 
-def report_build(report: BuildReport, root: Path) -> None:
+def report_build(report: BuildReport, root: Path, moved: dict[Path, Path] | None = None) -> None:
+    """Print what a build did: the dataset, why an old one was set aside, what each log
+    gave and what it left out (``moved``: logs set aside, to where)."""
     r = report
     note = ", rebuilt from the logs" if r.rebuilt else ""
     print(
         f"dataset {root}: {r.total_episodes} episodes (+{r.added}, {r.frames} frames in "
         f"{r.seconds:.2f} s{note})"
     )
+    if r.differences:
+        print(f"the dataset was kept as {r.aside} and rebuilt from the logs, as it:")
+        for line in r.differences[:20]:
+            print(f"  {line}")
+        if len(r.differences) > 20:
+            print(f"  ... and {len(r.differences) - 20} more")
+    for outcome in r.logs:
+        print(f"  {outcome}")
     if r.skipped_incomplete:
         print(
             f"left out {r.skipped_incomplete} unfinished episode(s) (the session stopped "
@@ -103,6 +116,8 @@ def report_build(report: BuildReport, root: Path) -> None:
         print("damaged logs: what could not be read is left out:", file=sys.stderr)
         for line in r.damage:
             print(f"  {line}", file=sys.stderr)
+    for path, target in (moved or {}).items():
+        print(f"set aside {path.name} as {target.name} (not deleted)", file=sys.stderr)
 
 
 def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
@@ -163,7 +178,8 @@ def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
     wanted = {ref: i for i, ref in [*base_refs([folder / LOGS]), *before] if ref is not None}
     unnamed = [i for i, ref in before if ref is None]  # episodes that record no log
     report = build_from_logs(logs, root, callsigns=callsigns or None)
-    report_build(report, root)
+    moved = {u.path: set_aside(u.path) for u in report.unreadable}
+    report_build(report, root, moved)
     after = dataset_refs(root)
     held = {ref for _, ref in after}
     lost: list[tuple[int, EpisodeRef | None]] = [

@@ -196,7 +196,10 @@ class DatasetBuilder:
         if self._writer is None:
             path = self.root / meta.data_path.format(chunk_index=chunk, file_index=file)
             path.parent.mkdir(parents=True, exist_ok=True)
-            self._writer = pq.ParquetWriter(path, schema=self._schema, compression="snappy")
+            # page checksums: `collect recover` finds a flipped byte in a data page
+            self._writer = pq.ParquetWriter(
+                path, schema=self._schema, compression="snappy", write_page_checksum=True
+            )
         self._writer.write_table(table)
         episode_meta = {
             "data/chunk_index": chunk,

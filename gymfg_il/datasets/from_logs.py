@@ -3,6 +3,11 @@
 The logs are the write-ahead log: a dataset can always be rebuilt from them, also after
 ``kill -9``. Every build happens on a copy of the dataset; the copy replaces the original only
 when it is complete, so a build that fails or is killed leaves the existing dataset as it was.
+
+The logs are the truth: an existing dataset is checked against them first (``verify``: every
+frame of every episode, its features and rate); one that cannot be read, or differs, is set
+aside as ``<root>.broken-<time>`` and rebuilt. An episode is taken once, however many logs
+hold it (a log copied under another name): by its frames.
 """
 
 from __future__ import annotations
@@ -23,12 +28,21 @@ import numpy as np
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs
-from gymfg_il.datasets.features import dataset_features
+from gymfg_il.datasets.features import check_compatible, dataset_features
+from gymfg_il.datasets.gather import (
+    LogOutcome,
+    Unreadable,
+    chosen_aircraft,
+    episodes_text,
+    no_logs,
+    read_logs,
+)
 from gymfg_il.datasets.health import dataset_problems
 from gymfg_il.datasets.provenance import metadata_columns
+from gymfg_il.datasets.verify import differences, digest
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views, episode_frames, image_key
 from gymfg_il.errors import ConfigError
-from gymfg_il.recording.reader import EmptyLog, Log, LoggedEpisode, read_log
+from gymfg_il.recording.reader import Log, LoggedEpisode
 from gymfg_il.viz.camera import Camera
 
 log = logging.getLogger(__name__)
@@ -46,6 +60,10 @@ class BuildReport:
     skipped_empty: list[str] = field(default_factory=list)  # logs never written to
     # the completed episodes of the logs a dataset may take (``episode_logs.unrebuildable``)
     logged: set[EpisodeRef] = field(default_factory=set)
+    logs: list[LogOutcome] = field(default_factory=list)  # what became of each log read
+    unreadable: list[Unreadable] = field(default_factory=list)  # files that are no log
+    differences: list[str] = field(default_factory=list)  # why the old dataset was set aside
+    aside: Path | None = None  # where it was kept
 
 
 def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarray]:
@@ -104,18 +122,6 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
     }
 
 
-def _dataset_ok(root: Path) -> bool:
-    """Whether the dataset at ``root`` is whole (``health.dataset_problems``) and its
-    metadata loads with LeRobot."""
-    if dataset_problems(root):
-        return False
-    try:
-        meta = lr.open_metadata(root)
-        return meta.episodes is None or len(meta.episodes) == meta.total_episodes
-    except Exception:  # any failure to load means: rebuild from the logs
-        return False
-
-
 def _clean_leftovers(root: Path) -> None:
     """Copies an interrupted build left beside the dataset (the good one is in place now)."""
     for pattern in (f"{root.name}.building-*", f"{root.name}.old-*"):
@@ -123,37 +129,52 @@ def _clean_leftovers(root: Path) -> None:
             shutil.rmtree(leftover, ignore_errors=True)
 
 
-def _present(root: Path) -> set[tuple[str, int, str]]:
-    eps = metadata_columns(lr.open_metadata(root))
-    if "gymfg/log" not in eps:
-        return set()
-    return set(zip(eps["gymfg/log"], eps["gymfg/log_episode"], eps["gymfg/callsign"], strict=True))
+def _refs(meta: Any) -> list[EpisodeRef | None]:
+    """The log episode each dataset episode names (None: it names none)."""
+    eps = metadata_columns(meta)
+    if not all(f"gymfg/{k}" in eps for k in ("log", "log_episode", "callsign")):
+        return [None] * meta.total_episodes
+    return [
+        EpisodeRef(str(name), int(k), str(c))
+        for name, k, c in zip(
+            eps["gymfg/log"], eps["gymfg/log_episode"], eps["gymfg/callsign"], strict=True
+        )
+    ]
 
 
-def _chosen(logs: list[Log], callsigns: Sequence[str] | None) -> list[tuple[Log, str]]:
-    """(log, callsign) of every aircraft to take, checked to share one layout and rate."""
-    chosen = [
-        (lg, c) for lg in logs for c in lg.session.get("callsigns", [])
-        if callsigns is None or c in callsigns
-    ]  # fmt: skip
-    if not chosen:
-        raise ConfigError(f"the logs hold no aircraft {list(callsigns or [])}")
-    first_log, first = chosen[0]
-    names = first_log.aircraft(first)["observation_names"]
-    fps = first_log.spec.agent_hz
-    for lg, c in chosen[1:]:
-        if lg.aircraft(c)["observation_names"] != names:
+def _check(
+    root: Path,
+    features: dict[str, Any],
+    fps: int,
+    logged: dict[EpisodeRef, dict[str, np.ndarray]],
+) -> tuple[list[str], list[EpisodeRef | None], list[str]]:
+    """(what keeps the dataset at ``root`` from being kept: it cannot be read whole, or it
+    differs from its logs; the log episode each of its episodes names; their digests).
+    Features or a rate other than the logs' are the dataset's damage when the logs hold every
+    episode it has (the logs are the truth), else ConfigError: another task's dataset."""
+    problems = dataset_problems(root)
+    if problems:
+        return problems, [], []
+    try:
+        meta = lr.open_metadata(root)
+    except Exception as err:  # any failure to load means: rebuild from the logs
+        return [f"LeRobot cannot load it ({type(err).__name__}: {err})"], [], []
+    if meta.episodes is None or len(meta.episodes) != meta.total_episodes:
+        return ["its episode table does not list every episode"], [], []
+    refs = _refs(meta)
+    try:
+        check_compatible(meta.features, features, str(root))
+        if meta.fps != fps:
             raise ConfigError(
-                f"{c!r} in {lg.path.name} observes other variables than {first!r} in "
-                f"{first_log.path.name}; one dataset holds one observation layout: build one "
-                "per task (choose the aircraft with callsigns=, `collect recover --callsign`)"
+                f"cannot append to the dataset at {root}: it was recorded at {meta.fps} fps, "
+                f"the new data at {fps}; use the same agent rate or another folder"
             )
-        if lg.spec.agent_hz != fps:
-            raise ConfigError(
-                f"{lg.path.name} records another rate ({lg.spec.agent_hz} Hz) than "
-                f"{first_log.path.name} ({fps} Hz); one dataset holds one fps"
-            )
-    return chosen
+    except ConfigError as err:
+        if refs and all(ref in logged for ref in refs):
+            return [f"its info.json disagrees with the logs of its episodes ({err})"], refs, []
+        raise
+    problems, digests = differences(root, meta, logged, refs)
+    return problems, refs, digests
 
 
 def build_from_logs(
@@ -192,16 +213,9 @@ def _build(
 ) -> BuildReport:
     lr.load()  # LeRobot's import is not build time
     started = time.perf_counter()
-    logs: list[Log] = []
-    empty: list[str] = []
-    for path in sorted(log_paths):
-        try:
-            logs.append(read_log(path))
-        except EmptyLog:
-            log.warning("skipped %s: a session stopped before writing anything to it", path)
-            empty.append(path.name)
+    logs, empty, unreadable = read_logs(log_paths)
     if not logs:
-        raise ConfigError(f"no trajectory logs to build {root} from")
+        raise no_logs(root, unreadable)
     # a DAgger session's linked base logs: only the base episodes, first, in the base's order
     base = [ref for _, ref in base_refs({p.parent for p in log_paths}) if ref is not None]
     only: dict[str, set[tuple[int, str]]] = {}
@@ -209,7 +223,7 @@ def _build(
         only.setdefault(ref.log, set()).add((ref.episode, ref.callsign))
     rank = {name: i for i, name in enumerate(dict.fromkeys(ref.log for ref in base))}
     logs.sort(key=lambda lg: (rank.get(lg.path.name, len(rank)), str(lg.path)))
-    chosen = _chosen(logs, callsigns)
+    chosen = chosen_aircraft(logs, callsigns)
     first_log, first = chosen[0]
     info = first_log.aircraft(first)
     views = check_views(first_log.session.get("images", []) if images is None else images)
@@ -219,52 +233,73 @@ def _build(
     fps = first_log.spec.agent_hz
     label = info["task"].get("task", "task")
     repo_id = repo_id or f"gymfg/{label}-{info['model']}"
+    # every episode the logs offer, in the order a build takes them
     taken = {(lg.path, c) for lg, c in chosen}
-    rebuilt = False
+    offered: list[tuple[Log, LoggedEpisode, str, EpisodeRef]] = []
+    for lg in logs:
+        wanted = only.get(lg.path.name)
+        for episode in lg.complete_episodes:
+            for callsign in episode.steps:  # in the order the flight lists them
+                if (lg.path, callsign) in taken and (
+                    wanted is None or (episode.index, callsign) in wanted
+                ):
+                    offered.append(
+                        (lg, episode, callsign, EpisodeRef(lg.path.name, episode.index, callsign))
+                    )
+    logged = {ref: episode_columns(ep, c) for _, ep, c, ref in offered}
     work = root.with_name(f"{root.name}.building-{time.time_ns()}")
-    if root.exists() and _dataset_ok(root):
-        shutil.copytree(root, work)
-        present = _present(work)
-    else:
-        if root.exists():
+    found: list[str] = []
+    refs: list[EpisodeRef | None] = []
+    digests: list[str] = []
+    aside = None
+    if root.exists():
+        found, refs, digests = _check(root, features, fps, logged)
+        if found:
             aside = root.with_name(f"{root.name}.broken-{time.strftime('%Y%m%d-%H%M%S')}")
             root.rename(aside)
             log.warning(
-                "the dataset at %s could not be read; kept it as %s and rebuilt it from the logs",
+                "the dataset at %s differs from its logs or cannot be read; kept it as "
+                "%s and rebuilt it: %s",
                 root,
                 aside,
+                "; ".join(found[:3]),
             )
-            rebuilt = True
-        present = set()
-    added = frames = skipped = 0
-    logged: set[EpisodeRef] = set()
+            refs, digests = [], []
+        else:
+            shutil.copytree(root, work)
+    outcomes = {lg.path.name: LogOutcome(lg.path.name) for lg in logs}
+    # an episode already held, or held by an earlier log: by its frames
+    holder: dict[str, EpisodeRef | int] = {}
+    for k, (held, d) in enumerate(zip(refs, digests, strict=True)):
+        holder.setdefault(d, k if held is None else held)
+    present = {held for held in refs if held is not None}
+    twins: dict[str, list[tuple[EpisodeRef, EpisodeRef | int]]] = {}
+    added = frames = 0
     try:
         builder = DatasetBuilder(work, repo_id, fps, features, robot_type=info["model"])
-        for lg in logs:
-            skipped += sum(1 for e in lg.episodes if not e.complete and not e.discarded)
-            for episode in lg.complete_episodes:
-                for callsign in episode.steps:  # in the order the flight lists them
-                    if (lg.path, callsign) not in taken:
-                        continue
-                    wanted = only.get(lg.path.name)
-                    if wanted is not None and (episode.index, callsign) not in wanted:
-                        continue
-                    logged.add(EpisodeRef(lg.path.name, episode.index, callsign))
-                    if (lg.path.name, episode.index, callsign) in present:
-                        continue
-                    columns = episode_columns(episode, callsign)
-                    pictures = {
-                        key: episode_frames(lg, episode, callsign, camera)
-                        for key, camera in cameras.items()
-                    }
-                    builder.add_episode(
-                        columns,
-                        lg.aircraft(callsign)["task_description"],
-                        episode_metadata(lg, episode, callsign),
-                        pictures,
-                    )
-                    added += 1
-                    frames += len(columns["action"])
+        for lg, episode, callsign, ref in offered:
+            outcome = outcomes[lg.path.name]
+            if ref in present:
+                outcome.held.append(ref)
+                continue
+            columns = logged[ref]
+            twin = holder.setdefault(digest(columns["observation.state"], columns["action"]), ref)
+            if twin != ref:
+                twins.setdefault(lg.path.name, []).append((ref, twin))
+                continue
+            pictures = {
+                key: episode_frames(lg, episode, callsign, camera)
+                for key, camera in cameras.items()
+            }
+            builder.add_episode(
+                columns,
+                lg.aircraft(callsign)["task_description"],
+                episode_metadata(lg, episode, callsign),
+                pictures,
+            )
+            outcome.added.append(ref)
+            added += 1
+            frames += len(columns["action"])
         builder.finalize(card_root=root)
         total = builder.meta.total_episodes
     except BaseException:
@@ -278,6 +313,40 @@ def _build(
     else:
         work.rename(root)
     _clean_leftovers(root)
+    for name, pairs in twins.items():
+        outcomes[name].left_out += _twin_lines(pairs)
+    skipped = sum(1 for lg in logs for e in lg.episodes if not e.complete and not e.discarded)
     damage = [f"{lg.path.name}: {note}" for lg in logs for note in lg.damage]
-    seconds = time.perf_counter() - started
-    return BuildReport(added, frames, skipped, total, seconds, rebuilt, damage, empty, logged)
+    damage += [f"{u.path.name}: not read: {u.why}" for u in unreadable]
+    return BuildReport(
+        added,
+        frames,
+        skipped,
+        total,
+        time.perf_counter() - started,
+        aside is not None,
+        damage,
+        empty,
+        set(logged),
+        list(outcomes.values()),
+        unreadable,
+        found,
+        aside,
+    )
+
+
+def _twin_lines(pairs: list[tuple[EpisodeRef, EpisodeRef | int]]) -> list[str]:
+    """One line per log (or dataset) whose episodes these repeat."""
+    by: dict[str, list[tuple[EpisodeRef, EpisodeRef | int]]] = {}
+    for ref, twin in pairs:
+        by.setdefault(twin.log if isinstance(twin, EpisodeRef) else "", []).append((ref, twin))
+    lines = []
+    for name, group in by.items():
+        mine = episodes_text(ref for ref, _ in group)
+        if name:
+            theirs = episodes_text(t for _, t in group if isinstance(t, EpisodeRef))
+            lines.append(f"episodes {mine}: the same episodes as {name} ({theirs})")
+        else:
+            held = ", ".join(str(t) for _, t in group)
+            lines.append(f"episodes {mine}: the same episodes as dataset episodes {held}")
+    return lines

@@ -1,0 +1,165 @@
+"""Checking what a dataset holds against the logs it was built from.
+
+The logs are the truth: a dataset is rebuilt from them whenever it differs. ``differences``
+reads every frame of the data files (their page checksums verified, where the builder wrote
+them) and compares each episode with the log episode it names, column by column as the
+builder stores it (float32 state, action and reward, the done and intervention flags, the
+environment state), and LeRobot's bookkeeping (episode, frame and global indexes, timestamps,
+task index) with what the episode table says. An episode no log holds is checked for its
+bookkeeping alone. Two episodes with the same frames, both of logs, are one episode twice.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.datasets.episode_logs import EpisodeRef
+from gymfg_il.datasets.features import ENVIRONMENT_STATE
+from gymfg_il.sim.properties import task_columns
+
+_BOOKKEEPING = ("episode_index", "frame_index", "index", "timestamp", "task_index")
+
+
+def digest(state: np.ndarray, action: np.ndarray) -> str:
+    """What identifies an episode's frames: its float32 states and actions, as stored."""
+    h = hashlib.blake2b(digest_size=16)
+    for values in (state, action):
+        a = np.ascontiguousarray(values, dtype=np.float32)
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _column(table: Any, name: str) -> np.ndarray:
+    """A column as numpy: fixed-size lists as (rows, width)."""
+    import pyarrow as pa
+
+    column = table[name].combine_chunks()
+    if pa.types.is_fixed_size_list(column.type):
+        width = column.type.list_size
+        return column.flatten().to_numpy(zero_copy_only=False).reshape(-1, width)
+    return column.to_numpy(zero_copy_only=False)
+
+
+def _frames(root: Path, features: Mapping[str, Any]) -> tuple[dict[str, np.ndarray], list[str]]:
+    """Every data file's non-video columns, concatenated; and what could not be read."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    names = [k for k, f in features.items() if f.get("dtype") != "video"]
+    names += [k for k in _BOOKKEEPING if k not in names]
+    tables, problems = [], []
+    for path in sorted((root / "data").rglob("*.parquet")):
+        where = path.relative_to(root)
+        try:
+            handle = pq.ParquetFile(path, page_checksum_verification=True)
+        except Exception as err:  # pyarrow raises several types for a damaged file
+            problems.append(f"{where} cannot be read ({err})")
+            continue
+        columns, bad = {}, []
+        for name in names:
+            try:
+                columns[name] = handle.read(columns=[name])[name]
+            except Exception as err:  # a page that fails its checksum, or will not decode
+                bad.append(f"{where}: its {name} column cannot be read ({err})")
+        problems += bad
+        if not bad:
+            tables.append(pa.table(columns))
+    if problems or not tables:
+        return {}, problems or ["data/ holds no data files"]
+    table = pa.concat_tables(tables)
+    return {name: _column(table, name) for name in table.column_names}, []
+
+
+def _expected(
+    columns: Mapping[str, np.ndarray], features: Mapping[str, Any]
+) -> dict[str, np.ndarray]:
+    """The frames the builder writes for a log episode's ``columns``, as stored."""
+    out = {k: np.asarray(v) for k, v in columns.items() if k in features}
+    if ENVIRONMENT_STATE in features:
+        names = features["observation.state"]["names"]
+        out[ENVIRONMENT_STATE] = out["observation.state"][:, task_columns(names)]
+    return {k: v.astype(features[k]["dtype"]) for k, v in out.items()}
+
+
+def _first_difference(have: np.ndarray, want: np.ndarray) -> int:
+    """The first frame where ``have`` and ``want`` differ (NaN equals NaN)."""
+    same = have == want
+    if have.dtype.kind == "f":
+        same |= np.isnan(have) & np.isnan(want)
+    return int(np.argmin(same.reshape(len(same), -1).all(axis=1)))
+
+
+def differences(
+    root: Path,
+    meta: Any,
+    logged: Mapping[EpisodeRef, Mapping[str, np.ndarray]],
+    refs: list[EpisodeRef | None],
+) -> tuple[list[str], list[str]]:
+    """(what in the dataset at ``root`` differs from its logs or itself, one line each; each
+    episode's ``digest``). ``logged``: the columns of every log episode at hand
+    (``from_logs.episode_columns``); ``refs``: the log episode each dataset episode names."""
+    features = meta.features
+    frames, problems = _frames(root, features)
+    if problems:
+        return problems, []
+    episodes = meta.episodes
+    order = np.argsort(frames["episode_index"], kind="stable")
+    held, starts, counts = np.unique(
+        frames["episode_index"][order], return_index=True, return_counts=True
+    )
+    where = {int(e): order[s : s + n] for e, s, n in zip(held, starts, counts, strict=True)}
+    tasks = len(meta.tasks) if meta.tasks is not None else 0
+    fps = float(meta.fps)
+    digests: list[str] = []
+    seen: dict[str, int] = {}
+    for e in range(len(episodes)):
+        row = episodes[e]
+        name = f"dataset episode {e}"
+        ref = refs[e] if e < len(refs) else None
+        rows = where.pop(e, np.zeros(0, dtype=np.int64))
+        n, start = int(row["length"]), int(row["dataset_from_index"])
+        if len(rows) != n or int(row["dataset_to_index"]) != start + n:
+            problems.append(f"{name}: the data files hold {len(rows)} frames, its table {n}")
+            digests.append("")
+            continue
+        steps = np.arange(n)
+        task = frames["task_index"][rows]
+        book = {
+            "frame_index": np.array_equal(frames["frame_index"][rows], steps),
+            "index": np.array_equal(frames["index"][rows], start + steps),
+            "timestamp": np.array_equal(
+                frames["timestamp"][rows], (steps / fps).astype(np.float32)
+            ),
+            "task_index": bool((task == task[0]).all() and 0 <= task[0] < tasks),
+        }
+        problems += [
+            f"{name}: its {k} column is not what it was written as"
+            for k, ok in book.items()
+            if not ok
+        ]
+        digests.append(digest(frames["observation.state"][rows], frames["action"][rows]))
+        if ref is None or ref not in logged:
+            continue
+        twin = seen.setdefault(digests[-1], e)
+        if twin != e:
+            problems.append(f"{name} ({ref}): the same episode as dataset episode {twin}")
+        for key, want in _expected(logged[ref], features).items():
+            have = frames[key][rows]
+            if have.shape != want.shape:
+                problems.append(
+                    f"{name} ({ref}): {key} has shape {have.shape}, its log {want.shape}"
+                )
+            elif not np.array_equal(have, want, equal_nan=have.dtype.kind == "f"):
+                at = _first_difference(have, want)
+                problems.append(f"{name} ({ref}): {key} differs from its log at frame {at}")
+    if where:
+        problems.append(
+            f"the data files hold frames of episodes {sorted(where)[:5]} no table lists"
+        )
+    return problems, digests

@@ -1,0 +1,202 @@
+"""`collect recover` checks the dataset against the logs and sets aside what it cannot use
+(red team findings #32.10, 12, 14, 15): the logs are the truth."""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from gymfg_il import collect
+from gymfg_il.collectors.autopilot import collect_autopilot
+from gymfg_il.collectors.config import CollectConfig
+from gymfg_il.recording.reader import read_log
+
+EPISODES, STEPS = 4, 60
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory):
+    out = tmp_path_factory.mktemp("recover") / "s"
+    cfg = CollectConfig(task="roll", episodes=EPISODES, episode_time_s=6, seed=3, out=out)
+    result, report = collect_autopilot(cfg)
+    assert report is not None and report.total_episodes == EPISODES
+    return out, result.log
+
+
+@pytest.fixture
+def copy(session, tmp_path):
+    out, _ = session
+    shutil.copytree(out, tmp_path / "s")
+    return tmp_path / "s"
+
+
+def frames(root):
+    table = pq.read_table(next((root / "data").rglob("*.parquet")))
+    return table.to_pydict()
+
+
+def log_states(folder):
+    """observation.state of every episode, as the log holds it (float32, in order)."""
+    (path,) = sorted((folder / "logs").glob("*.mcap"))
+    return np.concatenate(
+        [e.steps["ego"].observation.astype(np.float32) for e in read_log(path).complete_episodes]
+    )
+
+
+def test_damage_inside_a_data_page_is_found_and_rebuilt(copy, capsys):
+    """#32.10: flipped bytes inside a data page of the data file read back as other values;
+    recover said "4 episodes (+0)" and training read them."""
+    data = next((copy / "dataset" / "data").rglob("*.parquet"))
+    raw = data.read_bytes()
+    truth = log_states(copy)
+    column = (
+        pq.ParquetFile(data)
+        .metadata.row_group(0)
+        .column(pq.ParquetFile(data).schema_arrow.get_field_index("observation.state"))
+    )
+    start = column.data_page_offset
+    damaged = None
+    for offset in range(start + 64, start + column.total_compressed_size - 64, 97):
+        bad = bytearray(raw)
+        bad[offset] ^= 0x20
+        data.write_bytes(bytes(bad))
+        try:  # a flip that still reads, as other numbers
+            states = np.array(pq.read_table(data)["observation.state"].to_pylist(), np.float32)
+        except Exception:
+            continue
+        if states.shape == truth.shape and not np.array_equal(states, truth):
+            damaged = offset
+            break
+    assert damaged is not None
+    assert collect.main(["recover", str(copy)]) == 0
+    out = capsys.readouterr().out
+    assert "rebuilt from the logs" in out and "observation.state" in out
+    assert np.array_equal(np.array(frames(copy / "dataset")["observation.state"]), truth)
+    (aside,) = copy.glob("dataset.broken-*")  # the damaged copy is kept, never deleted
+    assert (next((aside / "data").rglob("*.parquet"))).read_bytes() == bytes(bad)
+
+
+def test_a_value_that_differs_from_the_log_is_rebuilt(copy, capsys):
+    """#32.10 without any checksum to help: a well-formed data file whose altitude is not
+    what the log says."""
+    data = next((copy / "dataset" / "data").rglob("*.parquet"))
+    table = pq.read_table(data)
+    states = np.array(table["observation.state"].to_pylist(), np.float32)
+    states[70, 0] = -0.0011
+    import pyarrow as pa
+
+    column = pa.FixedSizeListArray.from_arrays(pa.array(states.ravel()), states.shape[1])
+    index = table.schema.get_field_index("observation.state")
+    pq.write_table(table.set_column(index, table.schema.field(index), column), data)
+    assert collect.main(["recover", str(copy)]) == 0
+    out = capsys.readouterr().out
+    assert "episode 1" in out and "observation.state" in out
+    assert np.array_equal(np.array(frames(copy / "dataset")["observation.state"]), log_states(copy))
+
+
+def test_a_dataset_whose_features_were_damaged_is_set_aside_and_rebuilt(copy, capsys):
+    """#32.15: info.json's observation.state shape changed; recover refused to append."""
+    info = copy / "dataset" / "meta" / "info.json"
+    record = json.loads(info.read_text())
+    record["features"]["observation.state"]["shape"] = [99]
+    info.write_text(json.dumps(record))
+    assert collect.main(["recover", str(copy)]) == 0
+    assert "rebuilt from the logs" in capsys.readouterr().out
+    rebuilt = json.loads(info.read_text())["features"]["observation.state"]
+    assert rebuilt["shape"] == [len(rebuilt["names"])]
+    assert len(frames(copy / "dataset")["index"]) == EPISODES * STEPS
+    assert list(copy.glob("dataset.broken-*"))
+
+
+def test_a_dataset_whose_feature_names_were_damaged_is_rebuilt(copy, capsys):
+    info = copy / "dataset" / "meta" / "info.json"
+    record = json.loads(info.read_text())
+    record["features"]["observation.state"]["names"][0] = "roll_deh"
+    info.write_text(json.dumps(record))
+    assert collect.main(["recover", str(copy)]) == 0
+    assert "rebuilt from the logs" in capsys.readouterr().out
+    record = json.loads(info.read_text())
+    assert record["features"]["observation.state"]["names"][0] != "roll_deh"
+
+
+def test_a_copied_log_adds_nothing(copy, capsys):
+    """#32.14: the same log under another name doubled the dataset (8 episodes, not 4)."""
+    (log,) = (copy / "logs").glob("*.mcap")
+    shutil.copy(log, copy / "logs" / "aaa-copy.mcap")  # sorts before the original
+    assert collect.main(["recover", str(copy)]) == 0
+    out = capsys.readouterr().out
+    assert f"{EPISODES} episodes (+0" in out
+    assert "aaa-copy.mcap" in out and f"the same episodes as {log.name}" in out
+    shutil.rmtree(copy / "dataset")  # and rebuilt from both logs: each episode once
+    assert collect.main(["recover", str(copy)]) == 0
+    assert f"{EPISODES} episodes (+{EPISODES}" in capsys.readouterr().out
+
+
+def test_a_dataset_that_holds_an_episode_twice_is_rebuilt(copy, capsys):
+    """What the old recover made of a copied log: every episode twice."""
+    from gymfg_il.datasets.builder import DatasetBuilder
+    from gymfg_il.datasets.features import dataset_features
+    from gymfg_il.datasets.from_logs import episode_columns, episode_metadata
+
+    (log,) = (copy / "logs").glob("*.mcap")
+    twin = copy / "logs" / "zz-copy.mcap"
+    shutil.copy(log, twin)
+    shutil.rmtree(copy / "dataset")
+    first = read_log(log)
+    names = first.aircraft("ego")["observation_names"]
+    builder = DatasetBuilder(copy / "dataset", "gymfg/twice", 10, dataset_features(names))
+    for lg in (first, read_log(twin)):
+        for ep in lg.complete_episodes:
+            task = lg.aircraft("ego")["task_description"]
+            builder.add_episode(episode_columns(ep, "ego"), task, episode_metadata(lg, ep, "ego"))
+    builder.finalize()
+    assert collect.main(["recover", str(copy)]) == 0
+    out = capsys.readouterr().out
+    assert f"{EPISODES} episodes" in out and "rebuilt from the logs" in out
+    assert "the same episode as dataset episode 0" in out
+
+
+def test_unreadable_logs_are_set_aside_and_the_rest_rebuilt(copy, tmp_path):
+    """#32.12: 4,000 random bytes, a FIFO and a symlink to /dev/zero beside a good log
+    stopped the whole folder (exit 2, or a hang); each is set aside, named, and the rest
+    rebuilt. Run as a process: before, the FIFO blocked recover for ever."""
+    logs = copy / "logs"
+    (log,) = logs.glob("*.mcap")
+    (logs / "random.mcap").write_bytes(np.random.default_rng(0).bytes(4000))
+    os.mkfifo(logs / "fifo.mcap")
+    (logs / "zero.mcap").symlink_to("/dev/zero")
+    outside = tmp_path / "elsewhere.mcap"
+    shutil.copy(log, outside)
+    (logs / "outside.mcap").symlink_to(outside)
+    shutil.rmtree(copy / "dataset")
+    env = {**os.environ, "HF_HUB_OFFLINE": "1"}
+    run = subprocess.run(
+        [sys.executable, "-m", "gymfg_il.collect", "recover", str(copy)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=600,  # a deadline for the FIFO's old hang, not a timing
+    )
+    assert run.returncode == 1, run.stderr
+    text = run.stdout + run.stderr
+    assert f"{EPISODES} episodes (+{EPISODES}" in text
+    for name in ("random.mcap", "fifo.mcap", "zero.mcap", "outside.mcap"):
+        assert f"set aside {name}" in text
+        assert not (logs / name).exists(follow_symlinks=False)
+        assert (logs / f"{name}.set-aside").exists(follow_symlinks=False)
+    assert "not an MCAP file" in text and "a FIFO" in text and "symbolic link" in text
+    assert log.exists() and outside.exists()  # nothing deleted, nothing outside touched
+    # the next recover finds a clean folder
+    again = subprocess.run(
+        [sys.executable, "-m", "gymfg_il.collect", "recover", str(copy)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=600,
+    )
+    assert again.returncode == 0, again.stderr
