@@ -20,6 +20,14 @@ from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.videos import decode_camera, image_key
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, MixedTasksError, join_problems
+from gymfg_il.learning.data_checks import (
+    FEATURES,
+    column_problems,
+    meta_problems,
+    opened,
+    rebuild_hint,
+    stats_problems,
+)
 
 
 @dataclass
@@ -172,7 +180,7 @@ def check_tasks(episodes: dict[str, list[Any]], mixed_tasks: bool = False) -> No
 def dataset_flight(root: Path) -> tuple[FlightSpec | None, str, dict[str, Any]]:
     """The flight of the dataset at ``root`` (``flight_of``), without loading its frames;
     also its ``fps`` and ``observation_names``."""
-    meta = lr.open_metadata(Path(root))
+    meta = opened(Path(root), lr.open_metadata)
     spec, why = flight_of(metadata_columns(meta))
     found = {
         "fps": int(meta.fps),
@@ -204,20 +212,21 @@ def load_frames(root: Path, camera: str | None = None) -> Frames:
             f"no LeRobot dataset at {root} (no meta/info.json); collect one with "
             "`python -m gymfg_il.collect autopilot --out DIR` and pass DIR/dataset"
         )
-    problems = dataset_problems(root)
+    problems = meta_problems(root) or dataset_problems(root)
     if problems:
         raise ConfigError(
-            join_problems(f"the dataset at {root} is incomplete", problems)
-            + "\nRebuild it from its session's logs: python -m gymfg_il.collect recover "
-            + (str(root.parent) if (root.parent / "logs").is_dir() else "SESSION_DIR")
+            join_problems(f"the dataset at {root} is incomplete", problems) + rebuild_hint(root)
         )
-    ds = lr.open_dataset(root)
+    ds = opened(root, lr.open_dataset)
     features = ds.meta.features
-    for key in ("observation.state", "action"):
-        if key not in features:
-            raise ConfigError(f"the dataset at {root} has no {key!r} feature")
     table = ds.hf_dataset.data.table
     stats = ds.meta.stats
+    problems = column_problems(table, ds.meta.episodes, features)
+    problems += stats_problems(stats, {k: list(features[k]["names"]) for k in FEATURES})
+    if problems:
+        raise ConfigError(
+            join_problems(f"the dataset at {root} is damaged", problems) + rebuild_hint(root)
+        )
     episodes = metadata_columns(ds.meta)
     if ds.meta.episodes is not None:
         for name in ("episode_index", "length"):
