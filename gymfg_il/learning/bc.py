@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import time
@@ -10,8 +9,6 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
-
-import numpy as np
 
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.typecheck import type_problems
@@ -114,10 +111,15 @@ class TrainConfig:
             problems.append(f"threads={self.threads}: want 0 (torch decides) or more")
         if (self.epochs is not None and self.epochs < 1) or self.batch_size < 1:
             problems.append("epochs and batch_size must be >= 1")
-        if not (self.lr > 0 and math.isfinite(self.lr)):
-            problems.append(f"lr={self.lr} must be a positive number")
-        if not (self.weight_decay >= 0 and math.isfinite(self.weight_decay)):
-            problems.append(f"weight_decay={self.weight_decay} must be a number >= 0")
+        if not 0 < self.lr <= 1:  # AdamW moves each weight by about lr a step
+            problems.append(f"lr={self.lr} must lie in (0, 1] (default 1e-3)")
+        if not (self.weight_decay >= 0 and self.lr * self.weight_decay < 1):
+            problems.append(
+                f"weight_decay={self.weight_decay} must be >= 0 with lr x weight_decay < 1 "
+                "(each step shrinks the weights by that share)"
+            )
+        if not (self.obs_noise >= 0 and math.isfinite(self.obs_noise)):
+            problems.append(f"obs_noise={self.obs_noise} must be a number >= 0")
         if not self.hidden or min(self.hidden) < 1:
             problems.append(f"hidden={self.hidden} must be widths >= 1")
         if self.sequence_length < 2:
@@ -212,8 +214,11 @@ def _train(
     import torch
 
     from gymfg_il.learning.data import TensorBatches, check_tasks, load_frames, split_by_episode
+    from gymfg_il.learning.data_checks import check_trainable
+    from gymfg_il.learning.saving import check_diverged, save_run
+    from gymfg_il.policies.checkpoint_folder import check_out
     from gymfg_il.policies.configuration_vision import VisionConfig
-    from gymfg_il.policies.factory import PolicyConfig, make_config, make_policy, save_policy
+    from gymfg_il.policies.factory import PolicyConfig, make_config, make_policy
 
     device = resolve_device(cfg.device)
     camera = cfg.camera if cfg.policy == "vision" else None
@@ -233,6 +238,7 @@ def _train(
             "is nothing to learn from; add demonstrations (collect autopilot or manual)"
         )
     frames = shown
+    check_trainable(frames, cfg.dataset)
     flight, why = frames.flight()
     if flight is None:
         log.warning(
@@ -241,7 +247,7 @@ def _train(
     label = flight.task_label if flight else "task"
     name = f"bc-{label}-{flight.aircraft if flight else 'aircraft'}-{cfg.policy}"
     out = Path(cfg.out) if cfg.out is not None else Path("policies") / name
-    _check_out(out)  # before training, not after
+    check_out(out)  # before training, not after
     train, val = split_by_episode(frames, cfg.val_fraction, cfg.seed)
     torch.manual_seed(cfg.seed)
     sequence: int | None = None
@@ -291,6 +297,7 @@ def _train(
         opt, lambda s: 0.05 + 0.95 * 0.5 * (1 + math.cos(math.pi * min(s, steps) / steps))
     )
     train_loss, val_loss = [], []
+    settings = f"lr={cfg.lr}, weight_decay={cfg.weight_decay}, obs_noise={cfg.obs_noise}"
     started = time.perf_counter()
     for epoch in range(epochs):
         policy.train()
@@ -304,6 +311,8 @@ def _train(
             total += float(loss.detach()) * len(act)
             count += len(act)
         train_loss.append(total / count)
+        if not math.isfinite(train_loss[-1]):
+            check_diverged(policy, settings, epoch)
         val_loss.append(evaluate_loss(policy, val_batches) if val_batches else math.nan)
         if on_epoch is not None:
             on_epoch(epoch, train_loss[-1], val_loss[-1])
@@ -334,23 +343,10 @@ def _train(
             "seconds": seconds,
         },
     }
-    save_policy(policy.cpu(), out, meta, frames.obs_stats, frames.action_stats)
-    plot_losses(train_loss, val_loss, out / "loss.png", name)
-    (out / "train_log.json").write_text(
-        json.dumps({"train_loss": train_loss, "val_loss": val_loss}, indent=1)
-    )
+    check_diverged(policy, settings)
+    stats = (frames.obs_stats, frames.action_stats)
+    save_run(out, policy.cpu(), meta, stats, (train_loss, val_loss))
     return TrainResult(out, train_loss, val_loss, seconds, len(train) * epochs, meta)
-
-
-def _check_out(out: Path) -> None:
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f"--out {out} is a file; give a folder for the policy")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / ".write-check").touch()
-        (out / ".write-check").unlink()
-    except OSError as err:
-        raise ConfigError(f"--out {out}: cannot write there ({err.strerror})") from None
 
 
 def evaluate_loss(policy: Any, batches: Any) -> float:
@@ -363,26 +359,6 @@ def evaluate_loss(policy: Any, batches: Any) -> float:
             total += float(policy.loss(obs, act)) * len(act)
             count += len(act)
     return total / count
-
-
-def plot_losses(train: list[float], val: list[float], path: Path, title: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    epochs = np.arange(1, len(train) + 1)
-    ax.semilogy(epochs, train, label="train")
-    if not all(math.isnan(v) for v in val):
-        ax.semilogy(epochs, val, label="validation (held-out episodes)")
-    ax.set_xlabel("epoch")
-    ax.set_ylabel("MSE (normalised actions)")
-    ax.set_title(title)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
 
 
 def _observation_high(flight: FlightSpec | None) -> list[float] | None:

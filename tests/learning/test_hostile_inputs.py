@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from gymfg_il import eval as evaluate
+from gymfg_il import train
 from gymfg_il.policies.lerobot_allowed import UnsafeCheckpointError
 from gymfg_il.policies.lerobot_checkpoint import LeRobotAgent
 
@@ -147,3 +148,252 @@ def test_names_outside_lerobots_own_policies_are_refused(
     with pytest.raises(UnsafeCheckpointError) as err:
         LeRobotAgent(folder)
     assert needle in str(err.value)
+
+
+# --- train bc on damaged or non-finite datasets -------------------------------------------
+
+
+def damaged(tmp_path, how):
+    root = tmp_path / "dataset"
+    shutil.copytree(SAMPLE, root)
+    how(root)
+    return root
+
+
+def edit_json(path, change):
+    data = json.loads(path.read_text())
+    change(data)
+    path.write_text(json.dumps(data))
+
+
+def set_value(root, column, row, index, value):
+    """One value of one frame in the data file, written back as parquet."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = next((root / "data").rglob("*.parquet"))
+    table = pq.read_table(path)
+    cells = table.column(column).to_pylist()
+    cells[row][index] = value
+    at = table.schema.get_field_index(column)
+    field = table.schema.field(column)
+    pq.write_table(table.set_column(at, field, pa.array(cells, type=field.type)), path)
+
+
+def drop_column(path, column):
+    import pyarrow.parquet as pq
+
+    pq.write_table(pq.read_table(path).drop([column]), path)
+
+
+def truncate(path):
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 3])
+
+
+def episodes_table(root):
+    return next((root / "meta" / "episodes").rglob("*.parquet"))
+
+
+def bc(tmp_path, *args):
+    out = tmp_path / "p"
+    argv = ["bc", "--epochs", "1", "--hidden", "16", "--out", str(out), "--no-progress"]
+    return train.main([*argv, *args]), out
+
+
+@pytest.mark.parametrize(
+    "how, needles",
+    [
+        (lambda r: set_value(r, "observation.state", 5, 2, float("nan")),
+         ["episode 0 frame 5", "roll_deg=nan"]),
+        (lambda r: set_value(r, "action", 1807, 1, float("inf")),
+         ["episode 2 frame 7", "elevator=inf"]),
+        (lambda r: edit_json(r / "meta/stats.json",
+                             lambda d: d["observation.state"]["std"].__setitem__(2, float("nan"))),
+         ["observation.state std of roll_deg is nan"]),
+        (lambda r: edit_json(r / "meta/stats.json", lambda d: d["action"].update(mean=[0.0])),
+         ["action mean has shape (1,), want (4,)"]),
+    ],
+)  # fmt: skip
+def test_train_refuses_values_that_are_not_numbers(tmp_path, capsys, how, needles):
+    root = damaged(tmp_path, how)
+    code, out = bc(tmp_path, "--dataset", str(root))
+    assert code == 2
+    one_error(capsys, *needles)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "how, needle",
+    [
+        (lambda r: truncate(episodes_table(r)), "file-000.parquet is not readable parquet"),
+        (lambda r: truncate(r / "meta/tasks.parquet"), "tasks.parquet is not readable parquet"),
+        (lambda r: edit_json(r / "meta/info.json", lambda d: d.update(fps=0)), "fps=0"),
+        (lambda r: edit_json(r / "meta/info.json", lambda d: d.update(fps="10")), "fps='10'"),
+        (lambda r: (r / "meta/info.json").write_text("[1, 2]"), "holds a list"),
+        (lambda r: edit_json(r / "meta/info.json", lambda d: d.update(features=None)),
+         "no 'action' feature"),
+        (lambda r: edit_json(r / "meta/info.json", lambda d: d.update(total_episodes=99)),
+         "metadata and files disagree"),
+        (lambda r: edit_json(r / "meta/info.json", lambda d: d.update(codebase_version="v2.1")),
+         "BackwardCompatibilityError"),
+        (lambda r: drop_column(episodes_table(r), "length"), "has no 'length' column"),
+        (lambda r: drop_column(next((r / "data").rglob("*.parquet")), "action"),
+         "column 'action' has missing values"),
+        (lambda r: (r / "meta/stats.json").write_text("[]"), "LeRobot cannot read"),
+    ],
+)  # fmt: skip
+def test_train_on_damaged_metadata_is_one_line(tmp_path, capsys, how, needle):
+    root = damaged(tmp_path, how)
+    code, out = bc(tmp_path, "--dataset", str(root))
+    assert code == 2
+    one_error(capsys, needle, "collect recover")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--lr", "1e308"], "lr=1e+308 must lie in (0, 1]"),
+        (["--lr", "0.5", "--weight-decay", "4"], "lr x weight_decay < 1"),
+        (["--obs-noise", "nan"], "obs_noise=nan"),
+        (["--seed", "-1"], "seed=-1"),
+        (["--seed", str(2**70)], f"seed={2**70}"),
+    ],
+)
+def test_train_refuses_settings_that_cannot_train(tmp_path, capsys, args, needle):
+    code, out = bc(tmp_path, "--dataset", str(SAMPLE), *args)
+    assert code == 2
+    one_error(capsys, needle)
+    assert not out.exists()
+
+
+def test_a_run_that_diverges_saves_nothing(tmp_path):
+    """A step size inside the bounds that still blows the loss up: the run stops with an
+    error at the first non-finite epoch, and nothing is written."""
+    from gymfg_il.learning.bc import TrainConfig, train_bc
+    from gymfg_il.learning.saving import DivergedError
+
+    cfg = TrainConfig(
+        dataset=SAMPLE, out=tmp_path / "p", epochs=3, hidden=[16], lr=1.0, obs_noise=1e300
+    )
+    with pytest.raises(DivergedError, match="diverged in epoch 1") as err:
+        train_bc(cfg)
+    assert "obs_noise=1e+300" in str(err.value)
+    assert not (tmp_path / "p").exists()
+
+
+# --- saving over a policy: the whole old one or the whole new one --------------------------
+
+# Trains on the sample in a child process that SIGKILLs itself at one point of the save:
+# ``<module>:<function>:before|after`` (the function stays the real one; the kill comes just
+# before or just after it runs).
+KILLED_SAVE = """
+import importlib, os, signal, sys
+where, argv = sys.argv[1], sys.argv[2:]
+module, name, when = where.split(":")
+mod = importlib.import_module(module)
+real = getattr(mod, name)
+def dying(*args, **kwargs):
+    if when == "before":
+        os.kill(os.getpid(), signal.SIGKILL)
+    result = real(*args, **kwargs)
+    os.kill(os.getpid(), signal.SIGKILL)
+    return result
+setattr(mod, name, dying)
+from gymfg_il import train
+train.main(argv)
+"""
+
+
+def train_in_child(where, out, hidden):
+    import subprocess
+    import sys
+
+    argv = ["bc", "--dataset", str(SAMPLE), "--epochs", "1", "--hidden", str(hidden)]
+    argv += ["--out", str(out), "--no-progress"]
+    return subprocess.run(
+        [sys.executable, "-c", KILLED_SAVE, where, *argv],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+
+
+def policy_files(folder):
+    return {p.name: p.read_bytes() for p in folder.iterdir()}
+
+
+@pytest.fixture(scope="module")
+def old_policy(tmp_path_factory):
+    out = tmp_path_factory.mktemp("old") / "p"
+    argv = ["bc", "--dataset", str(SAMPLE), "--epochs", "1", "--hidden", "16"]
+    assert train.main([*argv, "--out", str(out), "--no-progress"]) == 0
+    return out
+
+
+@pytest.mark.parametrize(
+    "where, survivor",
+    [
+        ("safetensors.torch:save_file:before", "old"),  # config.json written, no weights
+        ("safetensors.torch:save_file:after", "old"),  # config and weights, no plot
+        ("gymfg_il.learning.saving:plot_losses:after", "old"),  # all but the log
+        ("gymfg_il.policies.checkpoint_folder:_swap_in:before", "old"),  # all staged
+        ("gymfg_il.policies.checkpoint_folder:_swap_in:after", "new"),  # swapped, not cleaned
+    ],
+)
+def test_a_save_killed_at_any_point_leaves_one_whole_policy(old_policy, tmp_path, where, survivor):
+    from gymfg_il.policies.factory import load_policy
+
+    out = tmp_path / "p"
+    shutil.copytree(old_policy, out)
+    before = policy_files(out)
+    done = train_in_child(where, out, hidden=32)
+    assert done.returncode == -9, done.stderr[-2000:]
+    after = policy_files(out)
+    hidden = json.loads(after["config.json"])["policy"]["hidden"]
+    if survivor == "old":
+        assert after == before
+    else:
+        assert hidden == [32] and set(after) == set(before)
+    load_policy(out)  # config and weights belong together
+    # what the kill left beside it goes with the next save, which replaces the policy whole
+    assert train.main(["bc", "--dataset", str(SAMPLE), "--epochs", "1", "--hidden", "8",
+                       "--out", str(out), "--no-progress"]) == 0  # fmt: skip
+    assert json.loads((out / "config.json").read_text())["policy"]["hidden"] == [8]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p"]
+
+
+def test_train_never_replaces_a_folder_that_holds_other_files(tmp_path, capsys):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep me")
+    argv = ["bc", "--dataset", str(SAMPLE), "--epochs", "1", "--out", str(out), "--no-progress"]
+    assert train.main(argv) == 2
+    one_error(capsys, "notes.txt", "give a new or empty folder")
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_without_an_atomic_exchange_the_old_policy_is_renamed_aside_and_back(
+    old_policy, tmp_path, monkeypatch
+):
+    """Where the system cannot swap two folders in one step, the old one is renamed aside
+    first; should a kill fall before the new one takes its place, the next save puts it back
+    (a process id that has ended marks the folder as left behind)."""
+    import subprocess
+    import sys
+
+    from gymfg_il.policies import checkpoint_folder
+
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)  # fmt: skip
+    shutil.copytree(old_policy, tmp_path / f".p.old-{int(ended.stdout)}")
+    with pytest.raises(RuntimeError), checkpoint_folder.staged(tmp_path / "p"):
+        raise RuntimeError("the save failed")
+    assert policy_files(tmp_path / "p") == policy_files(old_policy)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p"]
+
+    monkeypatch.setattr(checkpoint_folder, "_exchange", lambda a, b: False)
+    with checkpoint_folder.staged(tmp_path / "p") as folder:
+        (folder / "config.json").write_text("{}")
+    assert policy_files(tmp_path / "p") == {"config.json": b"{}"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p"]

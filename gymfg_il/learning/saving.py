@@ -1,0 +1,80 @@
+"""What a training run leaves on disk: the policy folder (``config.json``,
+``model.safetensors``), its loss curve (``loss.png``) and log (``train_log.json``), saved
+whole or not at all (``policies.checkpoint_folder.staged``), and never from a run whose loss
+or weights stopped being finite numbers (``--lr 1e308`` saved a policy of NaN weights with
+exit status 0)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.errors import ConfigError
+
+
+class DivergedError(ConfigError):
+    """Training whose loss or weights stopped being finite numbers; nothing is saved."""
+
+
+def check_diverged(policy: Any, settings: str, epoch: int | None = None) -> None:
+    """Refuse (``DivergedError``) a run at ``epoch``, whose loss was not finite, or (no
+    ``epoch``) a policy whose weights are not all finite; ``settings`` names the run's step
+    sizes for the message."""
+    import torch
+
+    if epoch is None and all(bool(torch.isfinite(t).all()) for t in policy.state_dict().values()):
+        return
+    when = f"in epoch {epoch + 1} (the loss is not finite)" if epoch is not None else ""
+    raise DivergedError(
+        f"training diverged {when or '(its weights are not finite)'} with {settings}; "
+        "nothing was saved: lower --lr (default 1e-3)"
+    )
+
+
+def save_run(
+    out: Path,
+    policy: Any,
+    meta: dict[str, Any],
+    stats: tuple[dict[str, np.ndarray], dict[str, np.ndarray]],
+    losses: tuple[list[float], list[float]],
+) -> None:
+    """Save the policy, its loss curve and log as the folder ``out``, replacing any older
+    policy there in one step."""
+    from gymfg_il.policies.checkpoint_folder import staged
+    from gymfg_il.policies.factory import save_policy
+
+    train, val = losses
+    try:
+        with staged(out) as folder:
+            save_policy(policy, folder, meta, *stats)
+            plot_losses(train, val, folder / "loss.png", str(meta["name"]))
+            text = json.dumps({"train_loss": train, "val_loss": val}, indent=1)
+            (folder / "train_log.json").write_text(text)
+    except OSError as err:
+        raise ConfigError(
+            f"cannot save the policy to {out} ({err}); free some space or give another --out"
+        ) from None
+
+
+def plot_losses(train: list[float], val: list[float], path: Path, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    epochs = np.arange(1, len(train) + 1)
+    ax.semilogy(epochs, train, label="train")
+    if not all(math.isnan(v) for v in val):
+        ax.semilogy(epochs, val, label="validation (held-out episodes)")
+    ax.set_xlabel("epoch")
+    ax.set_ylabel("MSE (normalised actions)")
+    ax.set_title(title)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
