@@ -14,6 +14,7 @@ import os
 from dataclasses import dataclass, field
 
 from gymfg_il.errors import ConfigError, UnknownAircraftError
+from gymfg_il.names import check_name
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,6 +124,7 @@ class Aircraft:
                 f"callsign must be a non-empty string, got {self.callsign!r}: "
                 'name the aircraft, e.g. c172p("red-one")'
             )
+        check_name(self.callsign, "callsign")  # it reaches logs, windows and the wire
         if self.profile is GENERIC_PROFILE and canonical in PROFILES:
             object.__setattr__(self, "profile", PROFILES[canonical])
 

@@ -130,9 +130,20 @@ def add_fields(
 
 
 def build(cls: type, ns: argparse.Namespace, **extra: Any) -> Any:
-    """An instance of ``cls`` from the namespace's values of its fields (and ``extra``)."""
+    """An instance of ``cls`` from the namespace's values of its fields (and ``extra``).
+
+    A ``--seed`` is held to the one seed rule (``typecheck.seed_problem``) here, for every
+    command, before the config sees it; a config that knows its episodes checks the last
+    episode's seed too."""
+    from gymfg_il.errors import ConfigError
+    from gymfg_il.typecheck import seed_problem
+
     names = {f.name for f in dataclasses.fields(cls)}
     values = {k: v for k, v in vars(ns).items() if k in names}
+    if values.get("seed") is not None:
+        problem = seed_problem(values["seed"])
+        if problem is not None:
+            raise ConfigError(f"--seed: {problem}")
     return cls(**{**values, **extra})
 
 

@@ -153,3 +153,93 @@ def test_a_zero_share_is_not_a_nan_percent():
         ratio_line(row)
         == "policy:p / controller: return 50.0%, success n/a (the controller's is 0)"
     )
+
+
+def test_eval_json_where_no_folder_can_be_is_refused_before_flying(tmp_path, capsys):
+    (tmp_path / "a-file").write_text("")
+    for flag in ("--json", "--plots"):
+        where = tmp_path / "a-file" / "sub" / ("r.json" if flag == "--json" else "plots")
+        argv = [flag, str(where), "--episodes", "1", "--episode-time", "1", "--no-progress"]
+        assert evaluate.main(argv) == 2
+        one_error(capsys, f"{flag} {where}", "is a file")
+
+
+SEED_RULE = "0 <= seed < 2**32"
+
+
+@pytest.mark.parametrize("seed", ["-1", str(2**32), str(2**64), str(2**70)])
+def test_every_commands_seed_is_checked_once(tmp_path, capsys, seed):
+    out = str(tmp_path / "out")
+    assert collect.main(["autopilot", "--seed", seed, "--out", out, "--no-progress"]) == 2
+    one_error(capsys, f"seed={seed}", SEED_RULE)
+    assert evaluate.main(["--seed", seed, "--episodes", "1", "--no-progress"]) == 2
+    one_error(capsys, f"seed={seed}", SEED_RULE)
+    argv = ["bc", "--dataset", str(SAMPLE), "--seed", seed, "--out", out, "--no-progress"]
+    assert train.main(argv) == 2
+    one_error(capsys, f"seed={seed}", SEED_RULE)
+    argv = ["dagger", "--policy", str(tmp_path / "p"), "--out", out, "--seed", seed]
+    assert collect.main(argv) == 2
+    one_error(capsys, f"seed={seed}", SEED_RULE)
+    recipe = tmp_path / "r.toml"
+    recipe.write_text(f"[collector]\nseed = {seed}\n")
+    assert collect.main([str(recipe), "--no-progress"]) == 2
+    one_error(capsys, f"seed={seed}", SEED_RULE)
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_last_episodes_seed_is_a_seed_too(tmp_path, capsys):
+    argv = ["--seed", str(2**32 - 2), "--episodes", "3", "--no-progress"]
+    assert evaluate.main(argv) == 2
+    one_error(capsys, "episode 2 has seed 4294967296", SEED_RULE)
+
+
+@pytest.mark.parametrize("time", ["1e308", "inf", "nan", "1e300"])
+def test_an_endless_episode_time_is_refused(tmp_path, capsys, time):
+    assert evaluate.main(["--episode-time", time, "--episodes", "1", "--no-progress"]) == 2
+    one_error(capsys, "episode_time_s=")
+    argv = ["autopilot", "--episode-time", time, "--out", str(tmp_path / "o"), "--no-progress"]
+    assert collect.main(argv) == 2
+    one_error(capsys, "episode_time_s=")
+
+
+@pytest.mark.parametrize(
+    "name", ["../../x-v0", "../x-v0", "a/../../x-v0", "/abs/x-v0", ".hidden-v0", "a\nb-v0"]
+)
+def test_a_minari_id_never_leaves_its_root(tmp_path, capsys, name):
+    root = tmp_path / "a" / "b" / "root"
+    root.mkdir(parents=True)
+    argv = ["export", "minari", str(SAMPLE), "--name", name, "--root", str(root)]
+    assert collect.main(argv) == 2
+    one_error(capsys, "--name", "Minari dataset id")
+    assert sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*")) == [
+        Path("a"), Path("a/b"), Path("a/b/root")
+    ]  # fmt: skip
+
+
+BAD_NAMES = ["red\nINFO forged line", "\x1b[31mred", "nul\x00", "\u202eder", "x" * 65, "zero\u200b"]
+
+
+@pytest.mark.parametrize("bad", BAD_NAMES)
+def test_callsigns_and_team_names_are_printable_and_short(bad):
+    from gymfg_il.aircraft import c172p
+    from gymfg_il.envs.team import Team
+    from gymfg_il.errors import ConfigError
+    from gymfg_il.names import RULE
+    from gymfg_il.tasks.library import DummyTask
+
+    with pytest.raises(ConfigError, match="callsign") as err:
+        c172p(bad)
+    assert RULE in str(err.value) and "\n" not in str(err.value)
+    with pytest.raises(ConfigError, match="team") as err:
+        Team(name=bad, roster=[(c172p("one"), DummyTask)])
+    assert RULE in str(err.value)
+    assert Team(name="red one", roster=[(c172p("x" * 64), DummyTask)]).callsigns == ["x" * 64]
+
+
+def test_acmi_out_where_nothing_can_be_written(tmp_path, capsys):
+    argv = ["autopilot", "--episodes", "1", "--episode-time", "1", "--out", str(tmp_path / "s")]
+    assert collect.main([*argv, "--no-progress"]) == 0
+    (tmp_path / "a-file").write_text("")
+    out = tmp_path / "a-file" / "x.acmi"
+    assert collect.main(["export", "acmi", str(tmp_path / "s"), "--out", str(out)]) == 2
+    one_error(capsys, f"--out {out}: cannot write there")

@@ -16,7 +16,7 @@ from gymfg_il.datasets.videos import check_views
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ
-from gymfg_il.typecheck import type_problems
+from gymfg_il.typecheck import seed_problem, type_problems
 
 
 @dataclass
@@ -130,6 +130,8 @@ class CollectConfig:
         least = 0 if self.kind == "manual" and self.pilot == "person" else 1
         if not isinstance(self.episodes, int) or self.episodes < least:
             problems.append(f"episodes={self.episodes!r} must be an integer >= {least}")
+        elif problem := seed_problem(self.seed, self.episodes):  # the last episode's seed
+            problems.append(problem)
         if not (
             isinstance(self.noise, (int, float)) and math.isfinite(self.noise) and self.noise >= 0
         ):

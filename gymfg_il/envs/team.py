@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 from gymfg_il.aircraft import Aircraft
 from gymfg_il.errors import ConfigError, DuplicateNameError, join_problems
+from gymfg_il.names import name_problem
 from gymfg_il.tasks.base import Task
 
 TaskSpec = type[Task] | Task | Callable[[], Task]
@@ -59,6 +60,8 @@ class Team:
         problems: list[str] = []
         if not isinstance(self.name, str) or not self.name.strip():
             problems.append(f"name must be a non-empty string, got {self.name!r}")
+        elif bad := name_problem(self.name, "team name"):  # it reaches logs and the wire
+            problems.append(bad)
         roster = list(self.roster) if isinstance(self.roster, (list, tuple)) else None
         if not roster:
             problems.append(
@@ -101,7 +104,7 @@ class Team:
         if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
             problems.append(f"episode_time_s must be a positive number of seconds, got {t!r}")
         if problems:
-            raise ConfigError(join_problems(f"Team {self.name!r}", problems))
+            raise ConfigError(join_problems(f"Team {self.name!r:.72}", problems))
         self.roster = roster
 
     @property

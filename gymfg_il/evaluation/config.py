@@ -4,6 +4,7 @@ the plan (what flies, on which seeds), the flights, and the JSON and plots it wr
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,6 +16,7 @@ from gymfg_il.evaluation.runner import evaluate, flight_for
 from gymfg_il.evaluation.trace import Trace
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.tasks.library import MANEUVERS
+from gymfg_il.typecheck import seed_problem
 from gymfg_il.workers import Workers
 
 TASKS = ("altitude", "roll", "pitch", "heading", "airspeed", "sideslip", "level", *MANEUVERS)
@@ -88,12 +90,40 @@ class EvalConfig:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 problems.append(f"{name}={value!r} must be an integer >= 1")
+        if isinstance(self.episodes, int) and (problem := seed_problem(self.seed, self.episodes)):
+            problems.append(problem)
+        self.json = None if self.json is None else Path(self.json)
+        self.plots = None if self.plots is None else Path(self.plots)
+        problems += filter(
+            None, [unwritable(self.json, "--json"), unwritable(self.plots, "--plots")]
+        )
         if problems:
             raise ConfigError(join_problems("eval", problems))
 
     @property
     def seeds(self) -> list[int]:
         return list(range(self.seed, self.seed + self.episodes))
+
+
+def unwritable(path: Path | None, flag: str) -> str | None:
+    """Why ``path`` (a file or folder to write, its folders made as needed) cannot be
+    written, or None: checked before anything flies, so that a run's results are not lost
+    at its end."""
+    if path is None:
+        return None
+    if flag == "--json" and path.is_dir():
+        return f"{flag} {path} is a folder; give a file name (e.g. {path / 'rows.json'})"
+    # the nearest part of the path that exists must be a folder this process may write in
+    there = path if flag != "--json" else path.parent
+    while not there.exists() and there != there.parent:
+        there = there.parent
+    if not there.is_dir():
+        return (
+            f"{flag} {path}: {there} is a file, so no folder can be made there; give another path"
+        )
+    if not os.access(there, os.W_OK | os.X_OK):
+        return f"{flag} {path}: cannot write in {there} (permission denied); give another path"
+    return None
 
 
 @dataclass
@@ -169,8 +199,11 @@ def run_eval(
         rows, traces = evaluate(flight, agents, seeds, pool, tick)
     run = EvalRun(flight, rows, traces, notes)
     if cfg.json:
-        cfg.json.parent.mkdir(parents=True, exist_ok=True)
-        cfg.json.write_text(json.dumps({"rows": rows}, indent=2))
+        try:
+            cfg.json.parent.mkdir(parents=True, exist_ok=True)
+            cfg.json.write_text(json.dumps({"rows": rows}, indent=2))
+        except OSError as err:  # the folder changed while the episodes flew
+            raise ConfigError(f"--json {cfg.json}: cannot write there ({err.strerror})") from None
         run.written.append(cfg.json)
     if cfg.plots:
         from gymfg_il.evaluation.plots import figure1, primary_control

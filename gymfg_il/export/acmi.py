@@ -246,14 +246,19 @@ def write_acmi(log_path: Path, out: Path | None = None, episode: int | None = No
     out = Path(out) if out is not None else log_path.with_suffix(".acmi")
     if out.suffix.lower() not in (".acmi", ".txt"):
         raise ConfigError(f"--out {out}: Tacview opens text recordings named *.acmi")
-    out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(out.name + ".tmp")
     frames = 0
-    with tmp.open("w", encoding="utf-8", newline="\n") as f:
-        for line in acmi_lines(log, episodes):
-            frames += line.startswith("#")
-            f.write(line + "\n")
-    tmp.replace(out)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with tmp.open("w", encoding="utf-8", newline="\n") as f:
+            for line in acmi_lines(log, episodes):
+                frames += line.startswith("#")
+                f.write(line + "\n")
+        tmp.replace(out)
+    except OSError as err:
+        raise ConfigError(
+            f"--out {out}: cannot write there ({err.strerror}); give a path you may write to"
+        ) from None
     objects = sum(len(e.steps) for e in episodes)
     return AcmiSummary(out, len(episodes), objects, frames)
 

@@ -45,10 +45,14 @@ import numpy as np
 
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
+from gymfg_il.names import BadNameError, name_problem
 
 DATA_FORMAT = "arrow"  # Minari's Arrow storage: pyarrow is here already (LeRobot); no h5py
 NEAR = 1e-3  # relative drift allowed when re-flying from float32 actions (no logs at hand)
-_ID = re.compile(r"^([\w.-]+/)*[\w.-]+-v\d+$")
+# each part starts with a letter, digit or underscore: no "..", ".", "/abs" or hidden parts,
+# so the id names a folder inside Minari's root and nowhere else
+_PART = r"\w[\w.-]*"
+_ID = re.compile(rf"^({_PART}/)*{_PART}-v\d+$")
 
 
 @dataclass
@@ -71,10 +75,13 @@ class MinariConfig:
     root: Path | None = None
 
     def __post_init__(self) -> None:
+        problem = name_problem(self.name, "Minari dataset id")
+        if problem is not None:
+            raise BadNameError(f"--name: {problem}")
         if not _ID.match(self.name):
-            raise ConfigError(
-                f"--name {self.name!r}: a Minari dataset id is (namespace/)name-vN, e.g. "
-                "gymfg/roll-c172p-v0"
+            raise BadNameError(
+                f"--name {self.name!r}: a Minari dataset id is (namespace/)name-vN, each part "
+                "starting with a letter, digit or underscore (no '..'), e.g. gymfg/roll-c172p-v0"
             )
 
 
@@ -304,6 +311,7 @@ def export_dataset(dataset: Path, name: str, root: Path | None = None) -> Minari
         env.close()
     sources = sorted(set(columns.get("gymfg/source", [])))
     with minari_root(root) as where, warnings.catch_warnings():
+        assert (where / name).resolve().is_relative_to(where), name  # the id's rule keeps it in
         for what in ("code_permalink", "author", "author_email", "eval_env"):
             warnings.filterwarnings("ignore", message=f"`{what}` is set to None")
         try:

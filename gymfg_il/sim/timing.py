@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
-from gymfg_il.errors import RateError
+import math
+
+from gymfg_il.errors import ConfigError, RateError
 
 DEFAULT_SIM_HZ = 120
 DEFAULT_AGENT_HZ = 10
+MAX_EPISODE_S = 86_400.0  # a day: longer is a typo (1e308 s overflowed into a traceback)
 
 
 def substeps(sim_hz: int, agent_hz: int) -> int:
@@ -24,6 +27,11 @@ def substeps(sim_hz: int, agent_hz: int) -> int:
 
 def episode_steps(episode_time_s: float, agent_hz: int) -> int:
     """Agent steps in an episode of ``episode_time_s`` seconds (must be a whole number)."""
+    if not (math.isfinite(episode_time_s) and 0 < episode_time_s <= MAX_EPISODE_S):
+        raise ConfigError(
+            f"episode_time_s={episode_time_s!r}: want seconds > 0 and at most "
+            f"{MAX_EPISODE_S:g} (a day)"
+        )
     steps = episode_time_s * agent_hz
     if steps < 1 or abs(steps - round(steps)) > 1e-9:
         raise RateError(
