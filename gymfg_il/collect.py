@@ -258,6 +258,12 @@ def _fly_by_hand(cfg: object, show_progress: bool = True) -> int:
         pilot_view=None if cfg.pilot_view == "none" else cfg.pilot_view,
         **synthetic,  # type: ignore[arg-type]
     )
+    if not synthetic:  # say in the terminal too what the session waits for
+        print(
+            "the window is open: Space in it starts an episode, E saves it, Backspace "
+            "discards it, Q quits (H: help)",
+            flush=True,
+        )
     try:
         stats = session.run()
     finally:

@@ -32,6 +32,7 @@ from gymfg_il.manual.bindings import (
     from_table,
 )
 from gymfg_il.manual.controller import ManualController
+from gymfg_il.manual.devices import check_person_can_fly
 from gymfg_il.manual.gui import ControlsGUI, GuiFrame
 from gymfg_il.manual.takeover import Takeover
 from gymfg_il.recording.recorder import new_log_path
@@ -57,16 +58,9 @@ COMMAND_KEYS = {
     "f1": "help",
 }
 SHOWN = (
-    "altitude_ft",
-    "airspeed_kts",
-    "vertical_speed_fps",
-    "heading_deg",
-    "roll_deg",
-    "pitch_deg",
-    "alpha_deg",
-    "beta_deg",
-    "thrust_lbs",
-)
+    "altitude_ft", "airspeed_kts", "vertical_speed_fps", "heading_deg", "roll_deg", "pitch_deg",
+    "alpha_deg", "beta_deg", "thrust_lbs",
+)  # fmt: skip
 
 
 def _check_assist_rate(meta: dict[str, Any], flight: FlightSpec, path: Path) -> None:
@@ -131,7 +125,9 @@ class ManualSession:
         max_episodes: stop after this many saved episodes (0 = until quit).
         realtime: pace frames to the wall clock at the env's rate.
         on_frame: called at the start of each frame (tests and the synthetic pilot inject
-            events with it).
+            events with it). Without it a person flies: a session with no window they can
+            see, or no joystick for ``device="joystick"``, is refused at once
+            (``manual.devices``), never left waiting for input that cannot come.
         views: FlightGear UDP ports showing the aircraft (out-the-window views).
         source: what the dataset calls the pilot (default: human, or ASSIST+human).
         draw: draw the window every frame (a headless synthetic pilot needs no pictures).
@@ -162,8 +158,9 @@ class ManualSession:
         image_size: int = DEFAULT_IMAGE_SIZE,
         pilot_view: str | None = "front",
     ) -> None:
-        bindings = bindings or {}
-        out = Path(out)
+        if on_frame is None:  # a person at the controls
+            check_person_can_fly(device)
+        bindings, out = bindings or {}, Path(out)
         check_out_folder(out)
         self.flight, self.out, self.seed, self.max_episodes = flight, out, seed, max_episodes
         self.realtime, self.on_frame = realtime, on_frame

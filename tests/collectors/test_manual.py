@@ -23,6 +23,11 @@ def key(k, down=True):
     pygame.event.post(pygame.event.Event(kind, key=k, mod=0, unicode="", scancode=0))
 
 
+def driven(frame, session):
+    """A test drives these sessions (a session without a driver is a person's, which needs a
+    real window: tests/collectors/test_manual_person.py)."""
+
+
 def run(out, script, **kwargs):
     def on_frame(frame, session):
         for event in script.get(frame, []):
@@ -150,7 +155,7 @@ def test_appending_another_task_is_refused(tmp_path):
     run(tmp_path, {1: [lambda: key(pygame.K_SPACE)], 200: [lambda: key(pygame.K_q)]})
     roll = FlightSpec.solo("c172p", "roll", episode_time_s=3, agent_hz=30)
     with pytest.raises(ConfigError, match="features differ"):
-        ManualSession(roll, tmp_path, realtime=False)
+        ManualSession(roll, tmp_path, realtime=False, on_frame=driven)
 
 
 def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
@@ -195,7 +200,7 @@ def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
         assert (view[20:60, :, 2] > view[20:60, :, 1]).mean() > 0.9
     # after rolling, the view changed
     assert np.abs(shots[2][100:420, 910:1230].astype(int) - shots[25][100:420, 910:1230]).mean() > 3
-    headless = ManualSession(SPEC, tmp_path / "b", realtime=False, pilot_view=None)
+    headless = ManualSession(SPEC, tmp_path / "b", realtime=False, pilot_view=None, on_frame=driven)
     assert headless.gui.size == (900, 600) and headless.camera is None
 
 
@@ -210,7 +215,7 @@ def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
     config = {"type": "mlp", "policy": {}, "obs_stats": stats, "action_stats": stats}
     (policy / "config.json").write_text(json.dumps({**config, "spec": spec.to_dict(), "fps": 10}))
     with pytest.raises(ConfigError, match=r"trained at 10 Hz.*at 30 Hz"):
-        ManualSession(SPEC, tmp_path / "out", assist=str(policy), realtime=False)
+        ManualSession(SPEC, tmp_path / "out", assist=str(policy), realtime=False, on_frame=driven)
 
 
 def test_the_dataset_helper_builds_on_request_and_outlives_a_crash(tmp_path, caplog):

@@ -1,6 +1,7 @@
 """A real window under Xvfb, real key presses from xdotool: the person's keys reach the data."""
 
 import os
+import select
 import shutil
 import subprocess
 import sys
@@ -11,24 +12,32 @@ import pytest
 pytestmark = pytest.mark.display
 
 NEEDED = [tool for tool in ("Xvfb", "xdotool") if shutil.which(tool) is None]
+DEADLINE_S = 180  # a loaded 2-core machine is slow; only a failure waits this long
 
 
 @pytest.fixture
 def display():
+    """An X server of our own: Xvfb picks a free display and says which (-displayfd), so a
+    display another test or person runs is never shared."""
     if NEEDED:
         pytest.skip(f"needs {', '.join(NEEDED)} (Debian: apt-get install xvfb xdotool)")
-    number = 90 + os.getpid() % 9
+    read, write = os.pipe()
     server = subprocess.Popen(
-        ["Xvfb", f":{number}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+        ["Xvfb", "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+        pass_fds=(write,),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
-    time.sleep(1.0)
+    os.close(write)
     try:
+        ready, _, _ = select.select([read], [], [], DEADLINE_S)  # written once it accepts
+        number = os.read(read, 64).decode().strip() if ready else ""
+        assert number.isdigit(), "Xvfb never said which display it serves"
         yield f":{number}"
     finally:
+        os.close(read)
         server.terminate()
-        server.wait(5)
+        server.wait(30)
 
 
 def xdo(display, *args):
@@ -37,7 +46,7 @@ def xdo(display, *args):
         env={**os.environ, "DISPLAY": display},
         capture_output=True,
         text=True,
-        timeout=10,
+        timeout=30,
     )
 
 
@@ -45,41 +54,35 @@ def test_keys_typed_into_a_real_window_become_the_dataset(display, tmp_path):
     env = {**os.environ, "DISPLAY": display, "HF_HUB_OFFLINE": "1"}
     env.pop("SDL_VIDEODRIVER", None)
     out = tmp_path / "session"
+    argv = ["manual", "--episodes", "1", "--episode-time", "4", "--out", str(out)]
     proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "gymfg_il.collect",
-            "manual",
-            "--episodes",
-            "1",
-            "--episode-time",
-            "4",
-            "--out",
-            str(out),
-        ],
+        [sys.executable, "-m", "gymfg_il.collect", *argv],
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
     )
     try:
-        # Xvfb runs no window manager: wait for the window to be mapped, then put the pointer
-        # over it (focus follows the pointer) and type as a person would.
+        # Xvfb runs no window manager: wait for the session's window to be mapped, then put
+        # the pointer over it (focus follows the pointer) and fly as a person would: Space
+        # starts the episode, Left held rolls left. Neither is timed: both are pressed again
+        # until the session, its one episode saved, exits (Space is ignored while flying;
+        # the start of an episode releases held keys, and the next press holds Left again).
+        deadline = time.monotonic() + DEADLINE_S
         window = ""
-        deadline = time.time() + 40
-        while not window and time.time() < deadline:
-            found = xdo(display, "search", "--onlyvisible", "--name", ".*").stdout.split()
+        while not window and proc.poll() is None and time.monotonic() < deadline:
+            # the display is ours alone, so any mapped window with a class is the session's
+            # (xdotool finds no window by its name here, with no window manager)
+            found = xdo(display, "search", "--onlyvisible", "--classname", ".").stdout.split()
             window = found[0] if found else ""
-            time.sleep(0.3)
+            time.sleep(0.2)
         assert window, "the GUI window never appeared"
-        time.sleep(1.0)
         xdo(display, "mousemove", "450", "300")
-        xdo(display, "key", "space")
-        time.sleep(0.5)
-        xdo(display, "keydown", "Left")
-        time.sleep(0.6)
+        while proc.poll() is None and time.monotonic() < deadline:
+            xdo(display, "key", "space")
+            xdo(display, "keydown", "Left")
+            time.sleep(0.2)
         xdo(display, "keyup", "Left")
-        output = proc.communicate(timeout=120)[0].decode()  # a loaded 2-core machine is slow
+        output = proc.communicate(timeout=30)[0].decode()
     finally:
         proc.kill()
     assert proc.returncode == 0, output
