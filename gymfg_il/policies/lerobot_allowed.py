@@ -17,7 +17,9 @@ names LeRobot's own policies write (LeRobot 0.6), collected here:
 
 Left out on purpose: steps that load code or tokenizers with ``trust_remote_code``
 (``action_tokenizer_processor``; pi0-FAST, GR00T, Wall-X) and robot/teleoperation steps no
-policy checkpoint holds.
+policy checkpoint holds. LeRobot is given the bytes that were checked (``checked_files``,
+copied into a private folder), never the checkpoint's folder again, which could have changed
+in between; the weights it reads from the folder are safetensors, which hold no code.
 """
 
 from __future__ import annotations
@@ -58,13 +60,18 @@ class UnsafeCheckpointError(ConfigError):
     do; refused before LeRobot imports or calls anything it names."""
 
 
-def check_checkpoint(folder: Path) -> None:
-    """Refuse (``UnsafeCheckpointError``, naming each offending entry) a checkpoint at
-    ``folder`` whose files name anything outside the allow-lists above."""
+def checked_files(folder: Path) -> dict[str, bytes]:
+    """The files of the checkpoint at ``folder`` that name things (``config.json`` and the
+    processor pipelines), with the state files the pipelines name, as read once and checked;
+    LeRobot is to load these bytes, not the folder, which may have changed since. Refuses
+    (``UnsafeCheckpointError``, naming each offending entry) anything outside the lists."""
     folder = Path(folder)
-    problems = _config_problems(folder / "config.json")
+    files = {n: d for n in ("config.json", *PROCESSOR_FILES) if (d := _bytes(folder / n))}
+    problems = _config_problems(_parsed(folder, "config.json", files))
+    states: list[str] = []
     for name in PROCESSOR_FILES:
-        problems += _pipeline_problems(folder, name)
+        if name in files:
+            problems += _pipeline_problems(name, _parsed(folder, name, files), states)
     if problems:
         head = f"the LeRobot checkpoint at {folder} names what GymFG does not load ({FIX})"
         raise UnsafeCheckpointError(
@@ -72,21 +79,31 @@ def check_checkpoint(folder: Path) -> None:
             if len(problems) > 1
             else f"{head}: {problems[0]}"
         )
+    for state in states:
+        if data := _bytes(folder / state):
+            files[state] = data  # one missing is LeRobot's to name
+    return files
 
 
-def _read(path: Path) -> Any:
+def _bytes(path: Path) -> bytes | None:
     try:
-        return json.loads(path.read_text())
+        return path.read_bytes()
     except FileNotFoundError:
         return None
-    except (OSError, UnicodeDecodeError, ValueError) as err:
-        raise UnsafeCheckpointError(f"{path} cannot be read as JSON ({err}); {FIX}") from None
+    except OSError as err:
+        raise UnsafeCheckpointError(f"{path} cannot be read ({err.strerror}); {FIX}") from None
 
 
-def _config_problems(path: Path) -> list[str]:
-    config = _read(path)
+def _parsed(folder: Path, name: str, files: dict[str, bytes]) -> Any:
+    try:
+        return json.loads(files.get(name, b"null"))
+    except (UnicodeDecodeError, ValueError) as err:
+        raise UnsafeCheckpointError(f"{folder / name} is not valid JSON ({err}); {FIX}") from None
+
+
+def _config_problems(config: Any) -> list[str]:
     if not isinstance(config, dict):
-        return [f"{path.name} is not a JSON object"]
+        return ["config.json is not a JSON object"]
     problems = []
     kind = config.get("type")
     if not (isinstance(kind, str) and kind in POLICY_TYPES):
@@ -102,10 +119,9 @@ def _config_problems(path: Path) -> list[str]:
     return problems
 
 
-def _pipeline_problems(folder: Path, name: str) -> list[str]:
-    pipeline = _read(folder / name)
-    if pipeline is None:
-        return []  # LeRobot says which file is missing; nothing in it is run
+def _pipeline_problems(name: str, pipeline: Any, states: list[str]) -> list[str]:
+    """What in the pipeline ``name`` is not on the lists; adds its state files to
+    ``states``."""
     steps = pipeline.get("steps") if isinstance(pipeline, dict) else None
     if not isinstance(steps, list):
         return [f"{name} holds no list of steps"]
@@ -133,6 +149,8 @@ def _pipeline_problems(folder: Path, name: str) -> list[str]:
         state = step.get("state_file")
         if state is not None and not _plain_file(state):
             problems.append(f"{where} state_file {state!r} is not a file name in the folder")
+        elif state is not None:
+            states.append(state)
     return problems
 
 

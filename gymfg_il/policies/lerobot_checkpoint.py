@@ -13,6 +13,7 @@ checkpoint's own pre- and post-processors (normalisation included).
 from __future__ import annotations
 
 import json
+import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -20,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.policies.lerobot_allowed import check_checkpoint
+from gymfg_il.policies.lerobot_allowed import checked_files
 from gymfg_il.sim.properties import task_columns
 
 STATE, ENVIRONMENT, IMAGES = (
@@ -79,21 +80,25 @@ class LeRobotAgent:
     the current state (``AgentSpec.make`` wires the env's camera)."""
 
     def __init__(self, folder: Path, device: str = "cpu") -> None:
-        check_checkpoint(folder)  # before LeRobot imports or calls anything the files name
+        checked = checked_files(folder)  # before LeRobot imports or calls anything they name
         import torch
         from lerobot.configs.policies import PreTrainedConfig
         from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 
         self.meta = lerobot_meta(folder)
         try:
-            cfg = PreTrainedConfig.from_pretrained(str(folder))
-            cfg.device = device
-            self.policy = get_policy_class(cfg.type).from_pretrained(str(folder), config=cfg)
-            self.pre, self.post = make_pre_post_processors(
-                policy_cfg=cfg,
-                pretrained_path=str(folder),
-                preprocessor_overrides={"device_processor": {"device": device}},
-            )
+            with tempfile.TemporaryDirectory(prefix="gymfg-lerobot-") as private:
+                for name, data in checked.items():  # LeRobot reads what was checked
+                    (Path(private) / name).write_bytes(data)
+                cfg = PreTrainedConfig.from_pretrained(private)
+                cfg.device = device
+                policy = get_policy_class(cfg.type).from_pretrained(str(folder), config=cfg)
+                self.pre, self.post = make_pre_post_processors(
+                    policy_cfg=cfg,
+                    pretrained_path=private,
+                    preprocessor_overrides={"device_processor": {"device": device}},
+                )
+            self.policy = policy
         except Exception as err:  # lerobot, draccus, torch and safetensors raise many types
             first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
             raise ConfigError(
