@@ -2,11 +2,11 @@
 follow JSBSim, read back through FlightGear's own property server."""
 
 import os
-import shutil
 import socket
-import subprocess
+import sys
 import time
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,7 +20,10 @@ from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks import LevelFlightTask
 from gymfg_il.tasks.geometry import offset_position
-from gymfg_il.viz.flightgear import FlightGear, FlightGearError, find_fgfs
+from gymfg_il.viz.flightgear import FlightGear, FlightGearError
+
+sys.path.insert(0, str(Path(__file__).parent))
+from waiting_fg import wait_flightgear_time, xvfb
 
 pytestmark = pytest.mark.flightgear
 
@@ -32,21 +35,9 @@ def free_port(kind=socket.SOCK_STREAM):
 
 
 @pytest.fixture
-def xvfb():
-    if find_fgfs() is None:
-        pytest.skip("FlightGear is not installed (Debian: apt-get install flightgear)")
-    if shutil.which("Xvfb") is None:
-        pytest.skip("Xvfb is not installed (Debian: apt-get install xvfb)")
-    display = f":{40 + os.getpid() % 20}"
-    server = subprocess.Popen(
-        ["Xvfb", display, "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    time.sleep(1)
-    yield display
-    server.terminate()
-    server.wait(10)
+def display():
+    with xvfb("1024x768x24") as display:
+        yield display
 
 
 def free_traffic_port():
@@ -71,12 +62,12 @@ def wing_ahead(rng, aircraft):
     return {ego.callsign: ic, wing.callsign: replace(ic, latitude_deg=lat, longitude_deg=lon)}
 
 
-def test_flightgear_follows_jsbsim(xvfb, tmp_path):
+def test_flightgear_follows_jsbsim(display, tmp_path):
     """One view follows "ego" through the native-fdm stream; its wingman flies in it as
     multiplayer traffic. Both, and a healthy engine with fuel, are read back from FlightGear."""
     started = time.monotonic()
     port, telnet, traffic = free_port(socket.SOCK_DGRAM), free_port(), free_traffic_port()
-    fg = FlightGear(port, telnet, display=xvfb, rate_hz=30, multiplayer_port=traffic)
+    fg = FlightGear(port, telnet, display=display, rate_hz=30, multiplayer_port=traffic)
     try:
         fg.wait_ready()
         team = Team("blue", [(c172p("wing"), LevelFlightTask), (c172p("ego"), LevelFlightTask)])
@@ -91,7 +82,9 @@ def test_flightgear_follows_jsbsim(xvfb, tmp_path):
         for _ in range(240):  # 8 s of flight, paced to real time by the view
             obs, *_ = env.step(np.hstack([p.act(o) for p, o in zip(pilots, obs, strict=True)]))
         flown = time.monotonic() - t0
-        time.sleep(3)  # FlightGear renders about one frame a second in software
+        # FlightGear draws a few frames a second in software (fewer on a busy machine), and
+        # shows multiplayer traffic a little behind its clock: 3 s of that clock
+        wait_flightgear_time(fg, 3.0)
         wing, ego = (s.state for s in env.world.slots)
         fuel_gal = env.world.slots[1].sim.fdm["propulsion/tank[0]/contents-lbs"] / 6.0
         shown = {p: fg.get_float(p) for p in (*SHOWN, "/consumables/fuel/tank[0]/level-gal_us")}
@@ -101,7 +94,7 @@ def test_flightgear_follows_jsbsim(xvfb, tmp_path):
         other_callsign = fg.get(mp + "/callsign")
         from PIL import ImageGrab
 
-        shot = ImageGrab.grab(xdisplay=xvfb)
+        shot = ImageGrab.grab(xdisplay=display)
         shot.save(tmp_path / "flightgear.png")
         if os.environ.get("GYMFG_SCREENSHOT"):  # how docs/flightgear.png is made
             shot.save(os.environ["GYMFG_SCREENSHOT"])
