@@ -40,3 +40,8 @@ def join_problems(what: str, problems: list[str]) -> str:
 
 class MixedTasksError(ConfigError):
     """A dataset whose episodes were flown in different tasks, trained as if they were one."""
+
+
+class UntrustedTaskError(ConfigError):
+    """A record read from a file names a task by import path whose module nobody imported:
+    building it would run code the file chose."""

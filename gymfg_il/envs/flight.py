@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 from gymfg_il.aircraft import Aircraft
 from gymfg_il.envs.config import EnvConfig
-from gymfg_il.envs.roster import AircraftSpec, TeamSpec, plain, unbuildable
+from gymfg_il.envs.roster import AircraftSpec, TeamSpec, plain, teams_from_record, unbuildable
 from gymfg_il.envs.scenarios import Scenario, scenario_from_record, scenario_record
 from gymfg_il.envs.team import Team
 from gymfg_il.errors import ConfigError, GymFGError, join_problems
@@ -258,20 +258,7 @@ class FlightSpec:
         unknown = sorted(set(data) - known)
         if unknown:
             raise ConfigError(f"flight spec record has unknown keys {unknown}")
-        try:
-            teams = tuple(
-                TeamSpec(
-                    t["name"],
-                    tuple(AircraftSpec(**a) for a in t["roster"]),
-                    {
-                        owner: tuple((x["callsign"], x["model"]) for x in targets)
-                        for owner, targets in t.get("reward_targets", {}).items()
-                    },
-                )
-                for t in data["teams"]
-            )
-        except (KeyError, TypeError) as err:
-            raise ConfigError(f"flight spec record is malformed ({err!r})") from None
+        teams = teams_from_record(data["teams"])
         settings = {k: data[k] for k in known - {"version", "teams"} if k in data}
         settings.setdefault("trimmed_starts", False)  # recorded before trimmed starts existed
         if "opponent_view" in settings:

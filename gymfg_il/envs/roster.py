@@ -12,10 +12,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from gymfg_il.aircraft import resolve_model
-from gymfg_il.errors import ConfigError
+from gymfg_il.errors import ConfigError, UntrustedTaskError
+from gymfg_il.names import check_name
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.tasks.base import Task
-from gymfg_il.tasks.library import TASK_FAMILIES, task_class
+from gymfg_il.tasks.library import TASK_FAMILIES, record_task_problem, task_class
 
 UNBUILDABLE = "python:"  # marks a recorded value that cannot be rebuilt from the record
 
@@ -97,8 +98,7 @@ class AircraftSpec:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "model", resolve_model(self.model))
-        if not isinstance(self.callsign, str) or not self.callsign.strip():
-            raise ConfigError(f"callsign must be a non-empty string, got {self.callsign!r}")
+        check_name(self.callsign, "callsign")
         if not isinstance(self.task_kwargs, Mapping):
             raise ConfigError(f"task_kwargs must be a mapping, got {self.task_kwargs!r}")
         object.__setattr__(self, "task_kwargs", plain(dict(self.task_kwargs)))
@@ -142,8 +142,7 @@ class TeamSpec:
     reward_targets: Mapping[str, tuple[tuple[str, str], ...]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name.strip():
-            raise ConfigError(f"a team name must be a non-empty string, got {self.name!r}")
+        check_name(self.name, "team name")
         object.__setattr__(self, "roster", tuple(self.roster))
         if not all(isinstance(a, AircraftSpec) for a in self.roster):
             raise ConfigError(f"team {self.name!r}: its roster must hold AircraftSpec entries")
@@ -168,3 +167,29 @@ class TeamSpec:
                 for owner, targets in self.reward_targets.items()
             },
         }
+
+
+def teams_from_record(records: Any) -> tuple[TeamSpec, ...]:
+    """The teams a flight spec record lists (``FlightSpec.to_dict()["teams"]``), read from a
+    file: a task named by import path whose module nobody imported is refused
+    (``UntrustedTaskError``), as building it would run code the file chose."""
+    try:
+        teams = tuple(
+            TeamSpec(
+                t["name"],
+                tuple(AircraftSpec(**a) for a in t["roster"]),
+                {
+                    owner: tuple((x["callsign"], x["model"]) for x in targets)
+                    for owner, targets in t.get("reward_targets", {}).items()
+                },
+            )
+            for t in records
+        )
+    except (KeyError, TypeError) as err:
+        raise ConfigError(f"flight spec record is malformed ({err!r})") from None
+    for team in teams:
+        for aircraft in team.roster:
+            problem = record_task_problem(aircraft.task)
+            if problem is not None:
+                raise UntrustedTaskError(problem)
+    return teams

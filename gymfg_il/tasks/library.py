@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import importlib
 import math
+import os
+import sys
 from typing import Any
 
 import numpy as np
@@ -288,6 +290,29 @@ def _import_task(path: str) -> type[Task]:
     if not (isinstance(found, type) and issubclass(found, Task)):
         raise ConfigError(f"{path!r} is {found!r}, not a Task class")
     return found
+
+
+TRUSTED_MODULES_ENV = "GYMFG_TASK_MODULES"
+
+
+def record_task_problem(name: object) -> str | None:
+    """Why the task ``name`` read from a record (a dataset, a log, a checkpoint: a file from
+    outside) may not be built, or None. A library family is always fine; an import path
+    ``package.module:ClassName`` is fine only when its module is imported already (the user's
+    own code did it, or gave it as ``--task``) or is listed in ``$GYMFG_TASK_MODULES``
+    (comma-separated): a file must never make GymFG import the code it names."""
+    if not isinstance(name, str) or ":" not in name:
+        return None
+    module = name.partition(":")[0]
+    trusted = {m.strip() for m in os.environ.get(TRUSTED_MODULES_ENV, "").split(",")}
+    if module in sys.modules or module in trusted:
+        return None
+    return (
+        f"the record names task {name!r}, whose module {module!r} is not imported; a dataset, "
+        "log or checkpoint may not make GymFG import code. If you trust that module, import "
+        f"it first (give --task {name}, or import it in your script) or set "
+        f"{TRUSTED_MODULES_ENV}={module}"
+    )
 
 
 def task_reference(cls: type[Task]) -> tuple[str, bool]:

@@ -182,3 +182,37 @@ def test_specs_are_immutable_hashable_and_check_their_parts():
     placed = spec.replace(scenario=scenario_record(lead))
     back = FlightSpec.from_json(placed.to_json())
     assert back == placed and back.env_config().scenario == lead
+
+
+def test_a_record_may_not_make_gymfg_import_the_task_it_names(tmp_path, monkeypatch):
+    """A dataset, log or checkpoint names its task; an import path whose module nobody
+    imported is refused before anything is imported (red team #32.1: files never run code)."""
+    from gymfg_il.errors import UntrustedTaskError
+
+    marker = tmp_path / "ran"
+    (tmp_path / "evil_task_module.py").write_text(
+        f"open({str(marker)!r}, 'w').write('ran')\n"
+        "from gymfg_il.tasks import DummyTask as Task\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    record = FlightSpec.solo("c172p", "altitude").to_dict()
+    record["teams"][0]["roster"][0]["task"] = "evil_task_module:Task"
+    with pytest.raises(UntrustedTaskError, match="evil_task_module.*not imported"):
+        FlightSpec.from_dict(record)
+    assert not marker.exists()
+    # the user's trust, given by name, lets it be built
+    monkeypatch.setenv("GYMFG_TASK_MODULES", "other, evil_task_module")
+    spec = FlightSpec.from_dict(record)
+    assert not marker.exists()  # reading the record still imports nothing
+    spec.solo_aircraft.task_factory()()
+    assert marker.read_text() == "ran"
+
+
+@pytest.mark.parametrize("name", ["red\nteam", "\x1b[2J", "a\x00", "\u202eder", "x" * 65, ""])
+def test_a_spec_refuses_names_that_are_not_printable(name):
+    from gymfg_il.envs.flight import AircraftSpec, TeamSpec
+
+    with pytest.raises(ConfigError, match="printable"):
+        TeamSpec(name, (AircraftSpec(),))
+    with pytest.raises(ConfigError, match="printable"):
+        AircraftSpec(callsign=name)
