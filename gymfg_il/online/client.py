@@ -22,12 +22,13 @@ from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import SimPool, World
 from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.online.link import ServerLink
-from gymfg_il.online.protocol import ServerError
+from gymfg_il.online.protocol import ServerError, printable
 from gymfg_il.sim.properties import ORIENTATION, POSITION
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 from gymfg_il.viz.peers import MultiplayerConfig
 
 _LEAVE_LINGER_MS = 250
+_FORGOTTEN = ("unknown", "dropped")  # error codes of a server that no longer has the team
 log = logging.getLogger(__name__)
 
 
@@ -128,10 +129,40 @@ class OnlineEnv:
         assert self.team is not None
         return self.link.request(msg, self.team.name, expect)
 
-    def _join(self) -> dict[str, Any]:
-        assert self.team is not None
-        aircraft = {a.callsign: a.model for a in self.team.aircraft}
-        return self._request({"type": "join", "aircraft": aircraft}, "welcome")
+    def _join(self) -> None:
+        """Join the server (again) and take the opponent view it announces."""
+        team, world = self.team, self.world
+        assert team is not None and world is not None
+        aircraft = {a.callsign: a.model for a in team.aircraft}
+        welcome = self._request({"type": "join", "aircraft": aircraft}, "welcome")
+        if welcome["team"] != team.name:
+            raise ServerError(
+                "malformed", f"the server welcomed team {welcome['team']!r}, not {team.name!r}"
+            )
+        self.view = tuple(welcome["opponent_view"])
+        self.link.width = len(self.view)
+        self.joined = True  # (the server has the team: leave() tells it the team leaves)
+        if self.config.multiplayer is not None:
+            self._show_peers()
+        if self.view != tuple(self.config.opponent_view):  # the server decides
+            for view in world.external.values():
+                view.rename(self.view)
+        pose = POSITION + ORIENTATION
+        self._pose_at = [self.view.index(n) for n in pose] if set(pose) <= set(self.view) else None
+
+    def _answer(self, done: bool) -> dict[str, Any]:
+        """The server's central state for the report just sent; a team the server has
+        forgotten meanwhile (dropped after a silence, or a new simulation) joins again and
+        reports anew."""
+        try:
+            return self.link.receive("central")
+        except ServerError as err:
+            if err.code not in _FORGOTTEN:
+                raise
+            log.warning("%s; joining again", err)
+        self._join()
+        self._send_report(done)
+        return self.link.receive("central")
 
     def _show_peers(self) -> None:
         """FlightGear aircraft in the server's opponent view: position and orientation only."""
@@ -139,7 +170,6 @@ class OnlineEnv:
         pose = POSITION + ORIENTATION
         extra = [n for n in self.view if n not in pose]
         if extra:
-            self.joined = True  # the server has the team: tell it the team leaves
             self.leave()
             raise ConfigError(
                 f"the server at {self.address} shows opponents' {extra}, which FlightGear "
@@ -152,13 +182,24 @@ class OnlineEnv:
         assert self.world is not None
         return {s.callsign: s.state.tolist() for s in self.world.slots}
 
+    def _send_report(self, done: bool) -> None:
+        assert self.team is not None
+        self.link.send({"type": "report", "states": self._states(), "done": done}, self.team.name)
+
     def _report(self, done: bool) -> dict[str, Any]:
-        return self._request({"type": "report", "states": self._states(), "done": done}, "central")
+        """Report the team's states; the server's answer (see ``_answer``)."""
+        self._send_report(done)
+        return self._answer(done)
 
     def _opponents(self, central: dict[str, Any]) -> np.ndarray:
         rows = central["opponents"]
         self.opponents = [r[0] for r in rows]
-        assert self.world is not None
+        assert self.world is not None and self.team is not None
+        own = set(self.opponents).intersection(self.team.callsigns)
+        if own:
+            raise ServerError(
+                "malformed", f"the server shows the team's own {sorted(own)} as opponents"
+            )
         # FlightGear aircraft this client hears, after the server's (which win a shared name)
         relayed = set(self.opponents)
         peers = [c for c in sorted(self.world.peers) if c not in relayed]
@@ -206,28 +247,16 @@ class OnlineEnv:
         if self.world is None or self.team is None:
             raise EnvStateError("the first reset needs your team: env.reset(team)")
         if not self.joined:
-            welcome = self._join()
-            self.view = tuple(welcome["opponent_view"])
-            if self.config.multiplayer is not None:
-                self._show_peers()
-            if self.view != tuple(self.config.opponent_view):  # the server decides
-                for view in self.world.external.values():
-                    view.rename(self.view)
-            pose = POSITION + ORIENTATION
-            self._pose_at = (
-                [self.view.index(n) for n in pose] if set(pose) <= set(self.view) else None
-            )
-            self.joined = True
+            self._join()
         if seed is not None:
             self._rng = np.random.default_rng(seed)
         overrides = dict((options or {}).get("initial_conditions", {}))
         self.world.reset(self._rng, overrides)
-        try:
-            central = self._report(done=False)
-        except ServerError as err:
-            if err.code != "unknown":
-                raise
-            self._join()  # the server forgot the team (a new simulation, a long absence)
+        central = self._report(done=False)
+        while central["done"]:  # the simulation ended as it began (a team completed at once)
+            reason = printable(central["reason"])
+            log.warning("%s: %s at its start; joining the next", self.address, reason)
+            self._join()
             central = self._report(done=False)
         self._done = False
         opponents = self._opponents(central)
@@ -241,9 +270,8 @@ class OnlineEnv:
             raise EnvStateError("call env.reset(team) before step (and again after the end)")
         world.step_physics(team_controls(team_actions, team.callsigns))
         terminated_now = all(s.terminated for s in world.slots)
-        link = self.link
-        link.send({"type": "report", "states": self._states(), "done": world.truncated}, team.name)
-        link.yield_after_send()
+        self._send_report(world.truncated)
+        self.link.yield_after_send()
         # Rewards and observations need the other teams only when a reward targets them:
         # otherwise they are computed while the server gathers the other reports.
         early = not world.external
@@ -251,7 +279,7 @@ class OnlineEnv:
             if early:
                 observations, rewards, terminated, info = self._outcome()
         finally:  # even when scoring fails, this tick's reply must not be left unread
-            central = link.receive("central")
+            central = self._answer(world.truncated)
         opponents = self._opponents(central)
         if central["done"]:  # the simulation ended: its roster is gone, join the next anew
             self.joined = False
@@ -262,7 +290,7 @@ class OnlineEnv:
         self._done = terminated or truncated
         info["tick"] = central["tick"]
         info["opponent_callsigns"] = list(self.opponents)
-        info["server_reason"] = central.get("reason", "")
+        info["server_reason"] = printable(central["reason"])
         return observations, opponents, rewards, terminated, truncated, info
 
     def _outcome(self) -> tuple[list[np.ndarray], np.ndarray, bool, dict[str, Any]]:

@@ -7,9 +7,10 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.names import name_problem
+from gymfg_il.online.protocol import MODES
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
 
-MODES = ("fixed", "open")
 ON_STALL = ("drop", "pause", "end")
 
 
@@ -33,18 +34,19 @@ class ServerConfig:
         teams: k, for the fixed mode.
         bind: address to listen on; loopback unless told otherwise.
         port: TCP port (0 picks a free one).
-        secrets: team -> secret; a team not listed needs ``shared_secret``.
+        secrets: team -> secret; a team not listed needs ``shared_secret``. Team names
+            follow ``gymfg_il.names`` (printable, 1 to 64 characters).
         shared_secret: one secret every team must present ("" and no per-team secrets = no
             authentication).
-        timeout_s: seconds of silence after which a team counts as stalled (while others
-            wait).
+        timeout_s: seconds of silence after which a team is dropped (its name and callsigns
+            are free again), or, where others wait for it, counts as stalled.
         on_stall: what a stalled team does to the others: drop it (it may rejoin), pause the
             others, or end the simulation.
         opponent_view: the state variables teams see of each other's aircraft (position and
             orientation by default).
         curve: encrypt with ZeroMQ CURVE; prints the public key clients need.
-        max_teams: teams a server holds at once (joined, flying, or away and allowed to
-            rejoin); more joins are refused as full.
+        max_teams: teams a server holds at once (joined or flying); more joins are refused
+            as full.
         insecure: listen on an address other than loopback although no secret is set
             (anyone who can reach it may then join and read every aircraft's position).
         batch_io: run the server's ZeroMQ I/O thread under Linux's SCHED_BATCH policy, so
@@ -85,6 +87,12 @@ class ServerConfig:
             problems.append(f"max_teams={self.max_teams} must lie in 1..100000")
         if self.mode == "fixed" and self.teams > self.max_teams:
             problems.append(f"teams={self.teams} exceeds max_teams={self.max_teams}")
+        for team, secret in self.secrets.items():
+            problem = name_problem(team, "team name")
+            if problem is not None:
+                problems.append(problem)
+            elif not (isinstance(secret, str) and secret):
+                problems.append(f"team {team!r} has an empty secret: give NAME:SECRET")
         no_secret = not (self.secrets or self.shared_secret)
         if no_secret and not self.insecure and not loopback(self.bind):
             problems.append(

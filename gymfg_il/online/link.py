@@ -13,7 +13,7 @@ import time
 from typing import Any
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.online.protocol import ProtocolError, ServerError, decode, encode
+from gymfg_il.online.protocol import ProtocolError, ServerError, decode, encode, printable
 from gymfg_il.online.threads import first_socket
 
 log = logging.getLogger(__name__)
@@ -73,12 +73,15 @@ class ServerLink:
             self.release()
             raise
         self._waiting = ""  # the last reason the server gave for making the team wait
+        self._team = ""  # the team the last message was sent for
+        self.width: int | None = None  # values per opponent row, once the server said
 
     def request(self, msg: dict[str, Any], team: str, expect: str) -> dict[str, Any]:
         self.send(msg, team)
         return self.receive(expect)
 
     def send(self, msg: dict[str, Any], team: str) -> None:
+        self._team = team
         self.sock.send(encode({**msg, "team": team, "token": self.token}))
 
     def yield_after_send(self) -> None:
@@ -116,8 +119,9 @@ class ServerLink:
         return data
 
     def receive(self, expect: str) -> dict[str, Any]:
-        """The next reply of type ``expect``; an error reply, a malformed message or a
-        silent server is a ``ServerError``; ``wait`` replies are logged once per reason."""
+        """The next reply, of type ``expect``. An error reply, a malformed message, a reply
+        of another type or a silent server is a ``ServerError``; ``wait`` replies are
+        answered (the team is still there) and logged once per reason."""
         import zmq
 
         while True:
@@ -130,19 +134,24 @@ class ServerLink:
                     f"{self.timeout_s:g} s; is the server running?",
                 ) from None
             try:
-                reply = decode(data, "server")
+                reply = decode(data, "server", self.width)
             except ProtocolError as err:
                 raise ServerError("malformed", f"the server sent a bad message: {err}") from None
-            if reply["type"] == "error":
-                raise ServerError(reply.get("code", "error"), reply.get("message", ""))
-            if reply["type"] == "wait":  # a paused or not yet started simulation
-                reason = str(reply.get("reason", ""))
-                if reason != self._waiting:  # said once per reason, not once per second
-                    log.warning("%s: %s", self.address, reason)
-                    self._waiting = reason
-                continue
-            if reply["type"] == expect:
+            kind = reply["type"]
+            if kind == expect:
                 return reply
+            if kind == "error":
+                raise ServerError(reply["code"], printable(reply["message"]))
+            if kind != "wait":
+                raise ServerError(
+                    "malformed", f"the server sent a {kind!r} message where a {expect!r} was due"
+                )
+            # a paused or not yet started simulation
+            self.send({"type": "alive"}, self._team)
+            reason = printable(reply["reason"])
+            if reason != self._waiting:  # said once per reason, not once per second
+                log.warning("%s: %s", self.address, reason)
+                self._waiting = reason
 
     def release(self) -> None:
         """End the context and give a pinned thread its CPUs back."""

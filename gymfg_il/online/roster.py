@@ -8,11 +8,15 @@ Rules the server relies on:
   with no secret at all lets anyone in (it says so loudly and listens on loopback only
   unless told otherwise; see ``StateServer``).
 - Bounds: at most ``max_teams`` records at once. When full, records of teams that are no
-  longer flying (left, dropped, finished) and have been silent for the stall timeout make
-  room, oldest first; otherwise the join is refused as full.
-- Freeing: a team that joined but never reported within the stall timeout gives its slot up;
-  the whole roster is cleared when a simulation ends, so a k-fixed server hosts one
-  simulation after another for any teams.
+  longer flying (finished) and have been silent for the stall timeout make room, oldest
+  first; otherwise the join is refused as full. A join that would let some team's central
+  state outgrow what a client accepts (``online.sizes``) is refused as too large.
+- Holding: a team holds its name and callsigns only while it is connected and reporting. A
+  team is silent when it owes the server a report (it has its reply, or has just joined) or
+  an answer to a ``wait`` (the server tells waiting teams why they wait, and they answer
+  ``alive``) for longer than the stall timeout; the server then drops it (``StateServer``),
+  and its name and callsigns are free again. The whole roster is cleared when a simulation
+  ends, so a k-fixed server hosts one simulation after another for any teams.
 """
 
 from __future__ import annotations
@@ -20,6 +24,9 @@ from __future__ import annotations
 import hmac
 import time
 from dataclasses import dataclass, field
+
+from gymfg_il.online.protocol import MAX_MESSAGE_BYTES
+from gymfg_il.online.sizes import largest_central, rows_bytes
 
 
 class Refused(Exception):
@@ -40,12 +47,26 @@ class TeamRecord:
     active: bool = False  # takes part in the lockstep
     report: dict[str, list[float]] | None = None  # this tick's report
     done: bool = False
-    reported: bool = False  # has reported at least once since it joined
+    # its last message, or the reply to its last report: it owes the server a message since
     last_seen: float = field(default_factory=time.monotonic)
+    asked: float | None = None  # when the first wait it has not answered was sent
     states: dict[str, list[float]] = field(default_factory=dict)  # latest
+    row_bytes: int = 0  # the most its rows take in the others' central states
 
     def __post_init__(self) -> None:
         self.members = frozenset(self.callsigns)
+
+    def heard(self, now: float) -> None:
+        """The team sent a message (a join, a report, an answer to a wait)."""
+        self.last_seen, self.asked = now, None
+
+    def silent_for(self, now: float) -> float:
+        """How long the team has owed the server a message: a report, once it has its reply
+        (or has just joined), or an answer to a wait, while it waits; 0 while it waits
+        unasked (the server owes it the reply)."""
+        if self.report is None:
+            return now - self.last_seen
+        return 0.0 if self.asked is None else now - self.asked
 
 
 class Roster:
@@ -58,6 +79,7 @@ class Roster:
         fixed_teams: k, for a k-fixed simulation (None: open).
         away_s: how long a team that is not flying keeps its record against newcomers when
             the roster is full (the stall timeout).
+        view_width: the values in each opponent row (the opponent view's length).
     """
 
     def __init__(
@@ -67,9 +89,11 @@ class Roster:
         max_teams: int,
         fixed_teams: int | None = None,
         away_s: float = 5.0,
+        view_width: int = 6,
     ) -> None:
         self.secrets, self.shared_secret = dict(secrets), shared_secret
         self.max_teams, self.fixed_teams, self.away_s = max_teams, fixed_teams, away_s
+        self.view_width = view_width
         self.teams: dict[str, TeamRecord] = {}
         self.owner: dict[str, str] = {}  # callsign -> team
 
@@ -112,7 +136,8 @@ class Roster:
             if sorted(known.callsigns) != sorted(callsigns):
                 raise Refused("roster", f"team {name!r} rejoined with other aircraft")
             known.identity, known.token = identity, token  # rejoin
-            known.report, known.done, known.last_seen = None, False, time.monotonic()
+            known.report, known.done = None, False
+            known.heard(time.monotonic())
             return known
         if self.fixed_teams is not None and len(self.teams) >= self.fixed_teams:
             raise Refused(
@@ -133,6 +158,16 @@ class Roster:
                 f"callsigns {taken} are taken by other teams; callsigns are unique in a simulation",
             )
         record = TeamRecord(name, identity, token, callsigns)
+        record.row_bytes = rows_bytes(name, callsigns, self.view_width)
+        largest = largest_central([t.row_bytes for t in self.teams.values()] + [record.row_bytes])
+        if largest > MAX_MESSAGE_BYTES:
+            raise Refused(
+                "too_large",
+                f"with team {name!r}'s {len(callsigns)} aircraft a team's central state could "
+                f"take {largest} bytes, and a client accepts {MAX_MESSAGE_BYTES} at most: join "
+                "with fewer aircraft or shorter callsigns and team name, or use a server with "
+                "fewer teams or a narrower --view",
+            )
         self.teams[name] = record
         for c in callsigns:
             self.owner[c] = name
@@ -153,17 +188,6 @@ class Roster:
         if team is not None:
             for c in team.callsigns:
                 self.owner.pop(c, None)
-
-    def free_unreported(self, now: float, timeout_s: float) -> list[str]:
-        """Give up the slots of teams that joined but never reported within ``timeout_s``."""
-        gone = [
-            t.name
-            for t in self.teams.values()
-            if not t.reported and not t.active and now - t.last_seen > timeout_s
-        ]
-        for name in gone:
-            self.remove(name)
-        return gone
 
     def clear(self) -> None:
         self.teams.clear()

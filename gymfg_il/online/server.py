@@ -4,16 +4,20 @@ assembles the central state and sends each team what it may see of the others.
 Modes: ``fixed`` (k teams: the simulation starts when all k have reported, further teams are
 refused, it ends when one team completes) and ``open`` (teams join at any step boundary and
 leave when they are done). The opponent restriction is applied here, so a client never
-receives more than the opponent view. A team that stops reporting for ``timeout_s`` is
-dropped (it may rejoin under its name and token), pauses the others, or ends the simulation,
-as configured. Malformed and oversized messages are refused with an error reply; the log says
-so in full a few times and then in one summary line per ten seconds, so a flood cannot flood
-the log. Who may join, and how many at once, is ``online.roster``'s business.
+receives more than the opponent view.
+
+A team that falls silent (it owes a report, or an answer to the ``wait`` messages that tell
+waiting teams why they wait, for ``timeout_s``) is dropped: its name and callsigns are free
+again and it may join anew, in every mode. Where other teams wait for its report, it may
+instead pause them (it is kept while they wait) or end the simulation, as configured. A
+team that leaves is dropped at once. Malformed and oversized messages are refused with an
+error reply; the log says so in full a few times and then in one summary line per ten
+seconds (``online.refusals``), so a flood cannot flood the log. Who may join, and how many
+at once, is ``online.roster``'s business.
 """
 
 from __future__ import annotations
 
-import collections
 import logging
 import time
 from typing import Any
@@ -21,46 +25,13 @@ from typing import Any
 from gymfg_il.errors import ConfigError
 from gymfg_il.online.config import ServerConfig
 from gymfg_il.online.protocol import MAX_MESSAGE_BYTES, ProtocolError, decode, encode
+from gymfg_il.online.refusals import RefusalLog
 from gymfg_il.online.roster import Refused, Roster, TeamRecord
 from gymfg_il.online.threads import first_socket
 from gymfg_il.sim.properties import indices
 
 __all__ = ["ServerConfig", "StateServer"]
 log = logging.getLogger(__name__)
-
-
-class RefusalLog:
-    """Refused messages in the log: the first few of every ``window_s`` in full, the rest
-    counted and summarised in one line when the window closes."""
-
-    def __init__(self, full: int = 5, window_s: float = 10.0) -> None:
-        self.full, self.window_s = full, window_s
-        self.start = time.monotonic()
-        self.logged = 0
-        self.quiet: collections.Counter[str] = collections.Counter()
-
-    def refused(self, code: str, message: str) -> None:
-        self.flush()
-        if self.logged < self.full:
-            self.logged += 1
-            log.warning("refused a message (%s): %s", code, message)
-        else:
-            self.quiet[code] += 1
-
-    def flush(self, now: float | None = None) -> None:
-        now = time.monotonic() if now is None else now
-        if now - self.start < self.window_s:
-            return
-        if self.quiet:
-            counts = ", ".join(f"{code}: {n}" for code, n in sorted(self.quiet.items()))
-            log.warning(
-                "refused %d more messages in the last %.0f s (%s)",
-                sum(self.quiet.values()),
-                now - self.start,
-                counts,
-            )
-        self.start, self.logged = now, 0
-        self.quiet.clear()
 
 
 class StateServer:
@@ -110,6 +81,7 @@ class StateServer:
             config.max_teams,
             config.teams if config.mode == "fixed" else None,
             config.timeout_s,
+            len(self.view_idx),
         )
         self.teams = self.roster.teams  # name -> record (the roster's own dict)
         self.refusals = RefusalLog()
@@ -125,6 +97,8 @@ class StateServer:
         self.refused = 0
         self._stop = False
         self._paused_notice = 0.0
+        # waiting teams hear why at this interval, and must answer within the timeout
+        self._wait_every = min(0.5, config.timeout_s / 4)
 
     @property
     def address(self) -> str:
@@ -192,21 +166,27 @@ class StateServer:
             return
         team.report, team.done = states, bool(msg.get("done", False))
         team.states = states
-        team.last_seen = time.monotonic()
-        team.active = team.reported = True  # (re)joins the lockstep at this step boundary
+        team.heard(time.monotonic())
+        team.active = True  # (re)joins the lockstep at this step boundary
         self._maybe_broadcast()
 
-    def _leave(self, identity: bytes, msg: dict[str, Any]) -> None:
+    def _own(self, identity: bytes, msg: dict[str, Any]) -> TeamRecord | None:
+        """The team that sent ``msg``, if it joined from this connection with this token."""
         team = self.teams.get(msg["team"])
-        if team is not None and team.identity == identity:
-            team.active, team.report, team.states = False, None, {}  # others stop seeing it
+        if team is None or team.identity != identity:
+            return None
+        return team if self.roster.same_token(team, msg.get("token", "")) else None
+
+    def _alive(self, identity: bytes, msg: dict[str, Any]) -> None:
+        team = self._own(identity, msg)  # (no answer: a stale one is harmless)
+        if team is not None:
+            team.heard(time.monotonic())
+
+    def _leave(self, identity: bytes, msg: dict[str, Any]) -> None:
+        team = self._own(identity, msg)
+        if team is not None:
             log.info("team %s left", team.name)
-            if self.config.mode == "fixed" and not self.running:
-                self.roster.remove(team.name)  # its slot of the coming simulation is free
-            elif self.running and not any(t.active for t in self.teams.values()):
-                self._new_simulation("every team left")
-                return
-            self._maybe_broadcast()
+            self._forget([team])
 
     # -- lockstep ------------------------------------------------------------------------
     def _maybe_broadcast(self) -> None:
@@ -227,7 +207,7 @@ class StateServer:
         end = (bool(done_teams) and self.config.mode == "fixed") or bool(reason)
         if done_teams and not reason:
             reason = f"team {done_teams[0]} completed"
-        view = self._view
+        view, now = self._view, time.monotonic()
         rows = {
             t.name: [[c, t.name, [t.states[c][i] for i in view]] for c in t.callsigns]
             for t in self.teams.values()
@@ -248,6 +228,7 @@ class StateServer:
                 },
             )
             team.report = None
+            team.last_seen = now  # it owes the next report from now on
         self.tick += 1
         if self.config.mode == "open":
             for team in active:
@@ -266,10 +247,16 @@ class StateServer:
             if missing > 0
             else "waiting for every team's first report"
         )
-        for t in active:
-            if t.report is not None:
-                self._send(t.identity, {"type": "wait", "reason": reason})
-        self._paused_notice = time.monotonic()
+        self._tell([t for t in active if t.report is not None], reason)
+
+    def _tell(self, waiting: list[TeamRecord], reason: str) -> None:
+        """Tell waiting teams why they wait; each must answer within the timeout."""
+        now = time.monotonic()
+        for t in waiting:
+            self._send(t.identity, {"type": "wait", "reason": reason})
+            if t.asked is None:
+                t.asked = now
+        self._paused_notice = now
 
     def _new_simulation(self, reason: str) -> None:
         """End the simulation; the roster is cleared, so any teams may play the next one
@@ -283,35 +270,47 @@ class StateServer:
     def _check_stalls(self) -> None:
         now = time.monotonic()
         self.refusals.flush(now)
-        for name in self.roster.free_unreported(now, self.config.timeout_s):
-            log.warning("freed the slot of team %s: it joined but never reported", name)
+        timeout = self.config.timeout_s
         active = [t for t in self.teams.values() if t.active]
-        waiting = [t for t in active if t.report is not None]
-        if self.config.mode == "fixed" and not self.running:
-            if waiting and now - self._paused_notice > 0.5:
-                self._tell_waiting(active)
+        starting = self.config.mode == "fixed" and not self.running
+        if starting and now - self._paused_notice > self._wait_every:
+            self._tell_waiting(active)
+        silent = [t for t in self.teams.values() if t.silent_for(now) > timeout]
+        if not silent:
             return
-        if not waiting:
-            if self.running and not active:  # everyone left or was dropped: start afresh
-                self._new_simulation("every team left")
+        waiting = [t for t in active if t.report is not None and t not in silent]
+        stalled = [t for t in silent if t.active and t.report is None]
+        if waiting and stalled and self.config.on_stall != "drop":  # they hold the others
+            names = _names(stalled)
+            if self.config.on_stall == "end":
+                self._broadcast(waiting, reason=f"team {names} stopped reporting")
+                return
+            # pause: the others wait for the stalled teams, which are kept meanwhile
+            silent = [t for t in silent if t not in stalled]
+            if now - self._paused_notice > self._wait_every:
+                self._tell(waiting, f"paused: waiting for {names}")
+        for t in silent:
+            log.warning(
+                "dropped team %s: silent for %.1f s; its name and callsigns are free",
+                t.name,
+                t.silent_for(now),
+            )
+            if t.report is not None:  # it waits: tell it (it may join again)
+                message = f"team {t.name!r} was dropped: it did not answer for {timeout:g} s"
+                self._send(t.identity, {"type": "error", "code": "dropped", "message": message})
+        self._forget(silent)
+
+    def _forget(self, teams: list[TeamRecord]) -> None:
+        """Drop ``teams`` from the roster (the others stop seeing them; their names and
+        callsigns are free), and go on without them."""
+        if not teams:
             return
-        stalled = [
-            t for t in active if t.report is None and now - t.last_seen > self.config.timeout_s
-        ]
-        if not stalled:
-            return
-        names = ", ".join(t.name for t in stalled)
-        if self.config.on_stall == "drop":
-            for t in stalled:
-                t.active, t.states = False, {}
-                log.warning("dropped team %s: silent for %.1f s", t.name, now - t.last_seen)
+        for t in teams:
+            self.roster.remove(t.name)
+        if self.running and not any(t.active for t in self.teams.values()):
+            self._new_simulation("every team left")
+        else:
             self._maybe_broadcast()
-        elif self.config.on_stall == "end":
-            self._broadcast(waiting, reason=f"team {names} stopped reporting")
-        elif now - self._paused_notice > 0.5:
-            self._paused_notice = now
-            for t in waiting:
-                self._send(t.identity, {"type": "wait", "reason": f"paused: waiting for {names}"})
 
     # -- loop ----------------------------------------------------------------------------
     def handle(self, identity: bytes, data: bytes) -> None:
@@ -320,9 +319,9 @@ class StateServer:
         except ProtocolError as err:
             self._error(identity, err.code, str(err))
             return
-        {"join": self._join, "report": self._report, "leave": self._leave}[msg["type"]](
-            identity, msg
-        )
+        {"join": self._join, "report": self._report, "alive": self._alive, "leave": self._leave}[
+            msg["type"]
+        ](identity, msg)
 
     def run(self, seconds: float | None = None) -> None:
         import zmq
@@ -354,3 +353,9 @@ class StateServer:
         if self.auth is not None:
             self.auth.stop()
         self.ctx.term()
+
+
+def _names(teams: list[TeamRecord]) -> str:
+    """One team's name, and how many more (a reason stays within ``sizes.REASON_MAX_BYTES``)."""
+    more = f" (and {len(teams) - 1} more)" if len(teams) > 1 else ""
+    return f"{teams[0].name}{more}"

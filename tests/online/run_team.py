@@ -1,7 +1,10 @@
 """A team's client process for the online tests: flies the paper's loop against a server and
-saves its states per step (``python run_team.py ADDRESS TOKEN TEAM SEED SECONDS OUT``)."""
+saves its states per step (``python run_team.py ADDRESS TOKEN TEAM SEED SECONDS OUT [SPIN_US
+[GO]]``; with GO, it starts up, prints ``ready`` and joins once the file GO exists)."""
 
 import sys
+import time
+from pathlib import Path
 
 import numpy as np
 
@@ -67,9 +70,14 @@ def fly(env, team, seed, on_step=None):
 if __name__ == "__main__":
     from gymfg_il.online.client import OnlineEnv
 
-    address, token, name, seed, seconds, out, *spin = sys.argv[1:8]
+    address, token, name, seed, seconds, out, *rest = sys.argv[1:9]
     team = teams(float(seconds))[name]
-    env = OnlineEnv(address, token=token, timeout_s=20, spin_us=float(spin[0]) if spin else 1000)
+    env = OnlineEnv(address, token=token, timeout_s=20, spin_us=float(rest[0]) if rest else 1000)
+    if len(rest) > 1:
+        go = Path(rest[1])
+        print("ready", flush=True)
+        while not go.exists():  # the test kills this process if its go never comes
+            time.sleep(0.01)
     states, info = fly(env, team, int(seed), lambda n: print(f"step {n}", flush=True))
     np.save(out, states)
     print(f"done {len(states)} {info['server_reason']}", flush=True)

@@ -16,12 +16,13 @@ from hypothesis import strategies as st
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.online.client import OnlineEnv
-from gymfg_il.online.protocol import ServerError, decode, encode
+from gymfg_il.online.protocol import VERSION, ServerError, decode, encode
 
 pytestmark = pytest.mark.network
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 import run_team  # noqa: E402
+from waiting import Lines, wait_until  # noqa: E402
 
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
 
@@ -33,18 +34,21 @@ def free_port():
 
 
 @pytest.fixture
-def server(request):
-    """Start ``python -m gymfg_il.serve`` with the test's options; yields its address."""
+def server(tmp_path):
+    """Start ``python -m gymfg_il.serve`` with the test's options; yields its address and
+    process (``proc.log``: its stderr, the server's log)."""
     procs = []
 
     def start(*options):
         port = free_port()
+        log = tmp_path / f"server{len(procs)}.log"
         proc = subprocess.Popen(
             [sys.executable, "-m", "gymfg_il.serve", "--port", str(port), *options],
             stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL,
+            stderr=open(log, "w"),  # noqa: SIM115 (the process owns it)
             env=ENV,
         )
+        proc.log = log
         procs.append(proc)
         assert b"serving" in proc.stdout.readline()
         return f"tcp://127.0.0.1:{port}", proc
@@ -52,10 +56,12 @@ def server(request):
     yield start
     for proc in procs:
         proc.terminate()
-        proc.wait(5)
+        proc.wait(10)
 
 
-def client(address, token, team, seed, seconds, out, spin_us=1000):
+def client(address, token, team, seed, seconds, out, spin_us=1000, go=None):
+    """A team's client process (``run_team.py``); with ``go``, it starts up, prints
+    ``ready`` and waits for that file before it joins."""
     return subprocess.Popen(
         [
             sys.executable,
@@ -67,6 +73,7 @@ def client(address, token, team, seed, seconds, out, spin_us=1000):
             str(seconds),
             str(out),
             str(spin_us),
+            *([str(go)] if go is not None else []),
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
@@ -128,19 +135,32 @@ def test_a_killed_client_neither_hangs_nor_crashes_the_others_and_can_rejoin(ser
     address, srv = server(
         "--mode", "fixed", "--teams", "2", "--secret", "s", "--timeout", "1", "--on-stall", "drop"
     )
+    go = tmp_path / "go"
     red = client(address, "s", "red", 1, 300, tmp_path / "red.npy")
     blue = client(address, "s", "blue", 1, 300, tmp_path / "blue.npy")
-    while b"step 20" not in blue.stdout.readline():
-        pass
-    blue.kill()
-    blue.wait()
-    time.sleep(1.5)  # dropped after its 1 s timeout; red goes on alone
-    again = client(address, "s", "blue", 1, 300, tmp_path / "blue2.npy")
-    out_red = red.communicate(timeout=60)[0].decode()
-    out_blue = again.communicate(timeout=60)[0].decode()
-    assert red.returncode == 0 and "done 3000" in out_red, out_red
-    assert again.returncode == 0 and "team red completed" in out_blue, out_blue
-    assert srv.poll() is None  # the server is still serving
+    # blue's second life starts up now (seconds on a busy machine) and joins on its go, so
+    # red, flying alone once blue is dropped, cannot finish before blue is back
+    again = client(address, "s", "blue", 1, 300, tmp_path / "blue2.npy", go=go)
+    procs = (red, blue, again)
+    try:
+        red_out, blue_out, again_out = (Lines(p) for p in procs)
+        again_out.wait_for("ready")
+        blue_out.wait_for("step 20")
+        blue.kill()
+        blue.wait()
+        # dropped after its 1 s timeout; red goes on alone
+        wait_until(lambda: "dropped team blue" in srv.log.read_text(), "blue dropped")
+        go.touch()
+        # deadlines on silence: a slow lockstep passes, a hung one fails
+        assert red_out.wait_for("done ") == "done 3000 team red completed", red_out.tail()
+        assert "team red completed" in again_out.wait_for("done "), again_out.tail()
+        assert red.wait(60) == 0 and again.wait(60) == 0
+        assert srv.poll() is None  # the server is still serving
+    finally:
+        for proc in procs:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
 
 
 def test_wrong_token_and_foreign_aircraft_are_refused(server):
@@ -184,11 +204,17 @@ def test_a_team_receives_only_the_opponent_view(server):
     socks["blue"].send(encode({"type": "report", "team": "blue", "states": {"blue-1": [0.0] * 26}}))
     decode(socks["blue"].recv(), "server")  # blue alone: tick 0
     socks["red"].send(encode({"type": "report", "team": "red", "states": {"red-1": secret}}))
-    time.sleep(0.3)  # red joins the lockstep before blue's next report
-    socks["blue"].send(encode({"type": "report", "team": "blue", "states": {"blue-1": [0.0] * 26}}))
-    central = decode(socks["blue"].recv(), "server")
-    assert central["type"] == "central"
-    assert central["opponents"] == [["red-1", "red", [2.0, 6.0]]]  # altitude, heading only
+
+    def blue_sees_red():  # blue flies alone until red's report joins it to the lockstep
+        socks["blue"].send(
+            encode({"type": "report", "team": "blue", "states": {"blue-1": [0.0] * 26}})
+        )
+        central = decode(socks["blue"].recv(), "server")
+        assert central["type"] == "central"
+        return central["opponents"]
+
+    opponents = wait_until(blue_sees_red, "red in blue's central state")
+    assert opponents == [["red-1", "red", [2.0, 6.0]]]  # altitude, heading only
     for s in socks.values():
         s.close(0)
 
@@ -209,7 +235,7 @@ def test_a_team_receives_only_the_opponent_view(server):
         ),
         st.fixed_dictionaries(
             {
-                "v": st.just(1),
+                "v": st.just(VERSION),
                 "type": st.sampled_from(["join", "report", "leave"]),
                 "team": st.text(max_size=70),
                 "states": st.dictionaries(

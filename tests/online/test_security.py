@@ -1,8 +1,6 @@
 """The online server against a red team: real server processes, real sockets."""
 
-import os
 import re
-import subprocess
 import sys
 import threading
 import time
@@ -19,34 +17,8 @@ from gymfg_il.online.protocol import ServerError, decode, encode
 from gymfg_il.tasks import DummyTask
 
 pytestmark = pytest.mark.network
-ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
-
-
-@pytest.fixture
-def serve(tmp_path):
-    """Start ``python -m gymfg_il.serve OPTIONS``; yields (address, process, stderr file)."""
-    procs = []
-
-    def start(*options, expect_serving=True):
-        err = tmp_path / f"server{len(procs)}.err"
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "gymfg_il.serve", "--port", "0", *options],
-            stdout=subprocess.PIPE,
-            stderr=open(err, "w"),  # noqa: SIM115 (the process owns it)
-            env=ENV,
-        )
-        procs.append(proc)
-        if not expect_serving:
-            proc.wait(30)
-            return None, proc, err
-        line = proc.stdout.readline().decode()
-        assert "serving" in line, err.read_text()
-        return line.split()[-1], proc, err
-
-    yield start
-    for proc in procs:
-        proc.terminate()
-        proc.wait(5)
+sys.path.insert(0, str(Path(__file__).parent))
+from waiting import wait_until  # noqa: E402
 
 
 def team(name, seconds=60.0):
@@ -107,8 +79,8 @@ def test_a_server_without_secrets_says_so_and_stays_on_loopback(serve):
     _, proc, err = serve("--bind", "0.0.0.0", expect_serving=False)
     assert proc.returncode == 2 and "--insecure" in err.read_text()
     address, _, err = serve()
-    time.sleep(0.5)
-    assert "no secrets given" in err.read_text() and "127.0.0.1" in address
+    wait_until(lambda: "no secrets given" in err.read_text(), "the warning in the log")
+    assert "127.0.0.1" in address
     address, *_ = serve("--bind", "0.0.0.0", "--insecure")
     assert address.startswith("tcp://0.0.0.0:")
 
@@ -125,7 +97,8 @@ def test_fixed_slots_are_freed_and_every_simulation_takes_new_teams(serve):
     third.setsockopt(zmq.RCVTIMEO, 5000)
     third.connect(address)
     assert raw_join(third, "red")["code"] == "full"
-    time.sleep(2.0)  # the squatters' slots are freed after the 1 s timeout
+    # the squatters' slots are freed after the 1 s timeout
+    wait_until(lambda: raw_join(third, "red")["type"] == "welcome", "a slot freed")
     assert fly_together(address, ["red", "blue"], 5) == {"red": 5, "blue": 5}
     # red completes (its episode ends): the simulation ends and the roster with it
     assert fly_together(address, ["green", "yellow"], 5) == {"green": 5, "yellow": 5}
@@ -153,17 +126,16 @@ def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve):
     codes = [r.get("code") for r in replies]
     assert 8 <= codes.count(None) <= admitted and codes.count("full") == 2000 - codes.count(None)
     assert rss_kb() - before < 20_000  # kB: the roster holds 8 teams, not 2000
-    time.sleep(2.5)  # the flood's teams never reported: their slots are free again
+    # the flood's teams never reported: their slots are free again after the timeout
+    wait_until(lambda: raw_join(sock, "legit")["type"] == "welcome", "a slot freed")
     out = {}
     fly(address, "legit", 3, out=out)
     assert out == {"legit": 3}
-    time.sleep(max(0.0, 10.5 - (time.monotonic() - started)))  # the log's window closes
+    summary = r"refused \d+ more messages in the last \d+ s \(full: \d+\)"
+    wait_until(lambda: re.search(summary, err.read_text()), "the summary when the window closes")
     sock.send(b"not msgpack")
-    decode(sock.recv(), "server")
-    time.sleep(0.3)
-    log = err.read_text()
-    assert log.count("refused a message") <= 6
-    assert re.search(r"refused \d+ more messages in the last \d+ s \(full: \d+\)", log)
+    assert decode(sock.recv(), "server")["code"] == "malformed"
+    assert err.read_text().count("refused a message") <= 6
     sock.close(0)
     ctx.term()
 
@@ -171,15 +143,51 @@ def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve):
 def test_a_team_waiting_for_the_others_hears_why_instead_of_timing_out(serve, caplog):
     import logging
 
-    address, *_ = serve("--mode", "fixed", "--teams", "2")
+    address, *_ = serve("--mode", "fixed", "--teams", "2", "--timeout", "1")
     out = {}
-    caplog.set_level(logging.WARNING, logger="gymfg_il.online.client")
+    caplog.set_level(logging.WARNING, logger="gymfg_il.online")
     # red gives up after 1.5 s of silence, and waits 3.5 s for blue: the server's wait
-    # messages (every half second) keep it waiting, and say what for
+    # messages keep it waiting, and say what for; red answers them, so the server, which
+    # drops a team silent for 1 s, keeps it
     first = threading.Thread(target=fly, args=(address, "red", 3, "", out, 1.5))
+    started = time.monotonic()
     first.start()
-    time.sleep(3.5)
-    assert "waiting for 1 more team to join" in caplog.text and out == {}
+    wait_until(
+        lambda: (
+            time.monotonic() - started > 3.5 and "waiting for 1 more team to join" in caplog.text
+        ),
+        "red told why it waits",
+    )
+    assert first.is_alive() and out == {}
     fly(address, "blue", 3, "", out)
     first.join(30)
+    assert out == {"red": 3, "blue": 3}
+
+
+def test_a_team_completing_at_its_first_report_ends_only_that_simulation(serve):
+    """k-fixed: a team that reports done at its first report ends the simulation as it
+    starts; the other team joins the next one instead of failing at its first step."""
+    address, *_ = serve("--mode", "fixed", "--teams", "2")
+    out = {}
+    red = threading.Thread(target=fly, args=(address, "red", 3, "", out), daemon=True)
+    red.start()
+    ctx = zmq.Context()
+    rogue = ctx.socket(zmq.DEALER)
+    rogue.setsockopt(zmq.RCVTIMEO, 20_000)
+    rogue.connect(address)
+    assert raw_join(rogue, "blue")["type"] == "welcome"
+    state = [0.5] * 26
+    rogue.send(
+        encode({"type": "report", "team": "blue", "states": {"blue-1": state}, "done": True})
+    )
+    while (reply := decode(rogue.recv(), "server"))["type"] != "central":
+        if reply["type"] == "wait":  # for red's first report
+            rogue.send(encode({"type": "alive", "team": "blue"}))
+    assert reply["done"] and reply["reason"] == "team blue completed"
+    rogue.close(0)
+    ctx.term()
+    blue = threading.Thread(target=fly, args=(address, "blue", 3, "", out), daemon=True)
+    blue.start()
+    for thread in (red, blue):
+        thread.join(120)
     assert out == {"red": 3, "blue": 3}

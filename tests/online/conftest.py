@@ -1,0 +1,37 @@
+"""Fixtures of the online tests: real server processes on loopback."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
+
+
+@pytest.fixture
+def serve(tmp_path):
+    """Start ``python -m gymfg_il.serve OPTIONS`` on a free port; yields (address, process,
+    log file: the server's stderr)."""
+    procs = []
+
+    def start(*options, expect_serving=True):
+        err = tmp_path / f"server{len(procs)}.err"
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "gymfg_il.serve", "--port", "0", *options],
+            stdout=subprocess.PIPE,
+            stderr=open(err, "w"),  # noqa: SIM115 (the process owns it)
+            env=ENV,
+        )
+        procs.append(proc)
+        if not expect_serving:
+            proc.wait(60)
+            return None, proc, err
+        line = proc.stdout.readline().decode()
+        assert "serving" in line, err.read_text()
+        return line.split()[-1], proc, err
+
+    yield start
+    for proc in procs:
+        proc.terminate()
+        proc.wait(10)

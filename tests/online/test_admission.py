@@ -1,0 +1,233 @@
+"""Who and what the server admits: names on the wire follow the one name rule, a central
+state never outgrows what a client accepts, and a team holds its name and callsigns only
+while it is connected and reporting. Real server processes, real sockets."""
+
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+import zmq
+
+from gymfg_il import serve as serve_cli
+from gymfg_il.errors import ConfigError
+from gymfg_il.names import RULE
+from gymfg_il.online.config import ServerConfig
+from gymfg_il.online.protocol import MAX_MESSAGE_BYTES, decode, encode
+from gymfg_il.sim.properties import NAMES
+
+pytestmark = pytest.mark.network
+sys.path.insert(0, str(Path(__file__).parent))
+from waiting import wait_until  # noqa: E402
+
+
+def dealer(ctx, address):
+    sock = ctx.socket(zmq.DEALER)
+    sock.setsockopt(zmq.RCVTIMEO, 20_000)
+    sock.setsockopt(zmq.LINGER, 0)
+    sock.connect(address)
+    return sock
+
+
+def join(sock, team, aircraft, token=""):
+    sock.send(encode({"type": "join", "team": team, "token": token, "aircraft": aircraft}))
+    return decode(sock.recv(), "server")
+
+
+def report(sock, team, callsigns, token=""):
+    states = {c: [0.5] * len(NAMES) for c in callsigns}
+    sock.send(encode({"type": "report", "team": team, "token": token, "states": states}))
+
+
+FORGED = "red\nFORGED INFO team blue joined (2 teams)"
+BAD_NAMES = {
+    "a newline": FORGED,
+    "ESC": "red\x1b[2J",
+    "NUL": "red\x00",
+    "a right-to-left override": "red\u202eder",
+    "65 characters": "r" * 65,
+    "nothing": "",
+}
+
+
+@pytest.mark.parametrize("where", ["team", "callsign", "aircraft model"])
+@pytest.mark.parametrize("bad", sorted(BAD_NAMES))
+def test_names_on_the_wire_are_printable_and_short(serve, where, bad):
+    address, _, log = serve("--mode", "open")
+    name = BAD_NAMES[bad]
+    team, callsign, model = (
+        name if where == w else ok
+        for w, ok in (("team", "red"), ("callsign", "red-1"), ("aircraft model", "c172p"))
+    )
+    ctx = zmq.Context()
+    sock = dealer(ctx, address)
+    try:
+        reply = join(sock, team, {callsign: model})
+        assert reply["type"] == "error" and reply["code"] == "malformed", reply
+        assert where in reply["message"] and RULE in reply["message"]
+        # the name reaches neither the log nor a reply unescaped
+        for text in (reply["message"], log.read_text()):
+            assert not any(c in text for c in "\x1b\x00\u202e") and "\nFORGED" not in text
+        # a report naming a callsign alike is refused too
+        assert join(sock, "red", {"red-1": "c172p"})["type"] == "welcome"
+        if where == "callsign":
+            states = {name: [0.5] * len(NAMES)}
+            sock.send(encode({"type": "report", "team": "red", "states": states}))
+            reply = decode(sock.recv(), "server")
+            assert reply["type"] == "error" and RULE in reply["message"]
+    finally:
+        sock.close(0)
+        ctx.term()
+
+
+@pytest.mark.parametrize("name", [FORGED, "red\x1b", "r" * 65, "red\u202e"])
+def test_serve_refuses_a_team_name_off_the_rule(capsys, name):
+    assert serve_cli.main(["--port", "0", "--seconds", "0.01", "--team", f"{name}:s3cret"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and RULE in err and err.count("\n") == 1
+    with pytest.raises(ConfigError, match="printable"):
+        ServerConfig(secrets={name: "s3cret"})
+
+
+def test_a_central_state_never_outgrows_what_a_client_accepts(serve):
+    """Teams of 64 callsigns of 60 characters under 60-character names: the join that would
+    make some team's central state larger than a client accepts is refused, saying so, and
+    every team admitted receives its central state whole."""
+    address, *_ = serve("--mode", "open", "--max-teams", "16")
+    ctx = zmq.Context()
+    admitted, refusal = {}, None
+    try:
+        for t in range(10):
+            name = f"{t}".rjust(60, "t")
+            callsigns = [f"{t}-{i}".rjust(60, "c") for i in range(64)]
+            sock = dealer(ctx, address)
+            reply = join(sock, name, dict.fromkeys(callsigns, "c172p"))
+            admitted[sock] = (name, callsigns)
+            if reply["type"] == "error":
+                refusal = reply
+                del admitted[sock]
+                sock.close(0)
+                break
+        assert refusal is not None, f"all {len(admitted)} teams admitted"
+        assert refusal["code"] == "too_large" and str(MAX_MESSAGE_BYTES) in refusal["message"]
+        assert "central state" in refusal["message"] and len(admitted) >= 5
+        # every team reports at every reply until the lockstep holds them all: then each
+        # receives the others' 64 rows
+        poller = zmq.Poller()
+        for sock, (name, callsigns) in admitted.items():
+            poller.register(sock, zmq.POLLIN)
+            report(sock, name, callsigns)
+        full, sizes = 64 * (len(admitted) - 1), {}
+
+        def all_see_all():
+            for sock, _ in poller.poll(100):
+                data = sock.recv()
+                central = decode(data, "server")
+                assert central["type"] == "central"
+                if len(central["opponents"]) == full:
+                    sizes[sock] = len(data)
+                else:
+                    report(sock, *admitted[sock])
+            return len(sizes) == len(admitted)
+
+        wait_until(all_see_all, "every team in the lockstep")
+        assert max(sizes.values()) <= MAX_MESSAGE_BYTES
+        # refused because one more team would not fit, not long before
+        assert max(sizes.values()) > MAX_MESSAGE_BYTES * (len(admitted) - 2) / (len(admitted) - 1)
+    finally:
+        for sock in admitted:
+            sock.close(0)
+        ctx.term()
+
+
+class Squatter(threading.Thread):
+    """A team that joins as ``team`` with ``callsigns``, reports, and keeps reporting (and
+    answering the server's waits) until ``leave_silently()``: then it falls silent with its
+    socket closed, as a killed process does."""
+
+    def __init__(self, address, team, callsigns, token):
+        super().__init__(daemon=True)
+        self.ctx = zmq.Context()
+        self.sock = dealer(self.ctx, address)
+        self.team, self.callsigns, self.token = team, callsigns, token
+        self.stop = threading.Event()
+        try:
+            reply = join(self.sock, team, dict.fromkeys(callsigns, "c172p"), token)
+            assert reply["type"] == "welcome", reply
+        except BaseException:
+            self.sock.close(0)
+            self.ctx.term()
+            raise
+        self.sock.setsockopt(zmq.RCVTIMEO, 50)
+        report(self.sock, team, callsigns, token)
+        self.start()
+
+    def run(self):
+        while not self.stop.is_set():
+            try:
+                reply = decode(self.sock.recv(), "server")
+            except zmq.Again:
+                continue
+            if reply["type"] == "central" and not self.stop.wait(0.05):
+                report(self.sock, self.team, self.callsigns, self.token)
+            elif reply["type"] == "wait":
+                self.sock.send(encode({"type": "alive", "team": self.team, "token": self.token}))
+        self.sock.close(0)
+        self.ctx.term()
+
+    def leave_silently(self):
+        self.stop.set()
+        self.join(30)
+
+
+SQUATS = {
+    # mode, server options, the squatter's team, token and callsigns, the refusal red meets
+    "open: another team's callsigns": (
+        ["--mode", "open", "--team", "red:r", "--team", "mal:m"],
+        ("mal", "m", ["red-1"]),
+        "taken by other teams",
+    ),
+    "open, pausing: another team's callsigns": (
+        ["--mode", "open", "--on-stall", "pause", "--team", "red:r", "--team", "mal:m"],
+        ("mal", "m", ["red-1"]),
+        "taken by other teams",
+    ),
+    "open, ending: another team's callsigns": (
+        ["--mode", "open", "--on-stall", "end", "--team", "red:r", "--team", "mal:m"],
+        ("mal", "m", ["red-1"]),
+        "taken by other teams",
+    ),
+    "open, shared secret: another team's name": (
+        ["--mode", "open", "--secret", "r"],
+        ("red", "r", ["mal-1"]),
+        "already connected",
+    ),
+    "fixed, before the start: another team's callsigns": (
+        ["--mode", "fixed", "--teams", "2", "--team", "red:r", "--team", "mal:m"],
+        ("mal", "m", ["red-1"]),
+        "taken by other teams",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(SQUATS))
+def test_a_team_holds_its_name_and_callsigns_only_while_it_reports(serve, case):
+    options, (team, token, callsigns), refused = SQUATS[case]
+    address, _, log = serve(*options, "--timeout", "0.5")
+    squatter = Squatter(address, team, callsigns, token)
+    ctx = zmq.Context()
+    red = dealer(ctx, address)
+    try:
+        reply = join(red, "red", {"red-1": "c172p"}, "r")  # the squatter reports: it holds
+        assert reply["type"] == "error" and refused in reply["message"], reply
+        squatter.leave_silently()
+        # silent for the timeout: dropped, its name and callsigns free again
+        wait_until(
+            lambda: join(red, "red", {"red-1": "c172p"}, "r")["type"] == "welcome",
+            f"red admitted after the squatter fell silent ({case})",
+        )
+        assert f"dropped team {team}" in log.read_text()
+    finally:
+        squatter.leave_silently()
+        red.close(0)
+        ctx.term()
