@@ -1,10 +1,10 @@
 """A team's client process for the online tests: flies the paper's loop against a server and
 saves its states per step (``python run_team.py ADDRESS TOKEN TEAM SEED SECONDS OUT [SPIN_US
-[GO]]``; with GO, it starts up, prints ``ready`` and joins once the file GO exists)."""
+[rejoin]]``; with ``rejoin``, it keeps trying to join while the server says the team is
+connected: a team coming back as soon as the server has dropped its killed self)."""
 
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -51,8 +51,21 @@ def pilots(env, team):
     ]
 
 
-def fly(env, team, seed, on_step=None):
-    team_state, opponents = env.reset(team, seed=seed)
+def fly(env, team, seed, on_step=None, rejoin=False):
+    from gymfg_il.online.protocol import ServerError
+
+    refusals = 0
+    while True:
+        try:
+            team_state, opponents = env.reset(team, seed=seed)
+            break
+        except ServerError as err:
+            if not (rejoin and err.code == "duplicate"):
+                raise
+            refusals += 1
+            if refusals == 1:
+                print(f"refused: {err}", flush=True)
+            time.sleep(0.01)  # (a client's retry interval; the test waits on its output)
     agents = pilots(env, team)
     for agent in agents:
         agent.reset(seed)
@@ -73,12 +86,8 @@ if __name__ == "__main__":
     address, token, name, seed, seconds, out, *rest = sys.argv[1:9]
     team = teams(float(seconds))[name]
     env = OnlineEnv(address, token=token, timeout_s=20, spin_us=float(rest[0]) if rest else 1000)
-    if len(rest) > 1:
-        go = Path(rest[1])
-        print("ready", flush=True)
-        while not go.exists():  # the test kills this process if its go never comes
-            time.sleep(0.01)
-    states, info = fly(env, team, int(seed), lambda n: print(f"step {n}", flush=True))
+    rejoin = rest[1:] == ["rejoin"]
+    states, info = fly(env, team, int(seed), lambda n: print(f"step {n}", flush=True), rejoin)
     np.save(out, states)
     print(f"done {len(states)} {info['server_reason']}", flush=True)
     env.close()

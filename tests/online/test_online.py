@@ -59,9 +59,9 @@ def server(tmp_path):
         proc.wait(10)
 
 
-def client(address, token, team, seed, seconds, out, spin_us=1000, go=None):
-    """A team's client process (``run_team.py``); with ``go``, it starts up, prints
-    ``ready`` and waits for that file before it joins."""
+def client(address, token, team, seed, seconds, out, spin_us=1000, rejoin=False):
+    """A team's client process (``run_team.py``); with ``rejoin``, it keeps trying to join
+    while the server says the team is connected."""
     return subprocess.Popen(
         [
             sys.executable,
@@ -73,7 +73,7 @@ def client(address, token, team, seed, seconds, out, spin_us=1000, go=None):
             str(seconds),
             str(out),
             str(spin_us),
-            *([str(go)] if go is not None else []),
+            *(["rejoin"] if rejoin else []),
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
@@ -135,26 +135,26 @@ def test_a_killed_client_neither_hangs_nor_crashes_the_others_and_can_rejoin(ser
     address, srv = server(
         "--mode", "fixed", "--teams", "2", "--secret", "s", "--timeout", "1", "--on-stall", "drop"
     )
-    go = tmp_path / "go"
     red = client(address, "s", "red", 1, 300, tmp_path / "red.npy")
     blue = client(address, "s", "blue", 1, 300, tmp_path / "blue.npy")
-    # blue's second life starts up now (seconds on a busy machine) and joins on its go, so
-    # red, flying alone once blue is dropped, cannot finish before blue is back
-    again = client(address, "s", "blue", 1, 300, tmp_path / "blue2.npy", go=go)
-    procs = (red, blue, again)
+    procs = [red, blue]
     try:
-        red_out, blue_out, again_out = (Lines(p) for p in procs)
-        again_out.wait_for("ready")
-        blue_out.wait_for("step 20")
+        red_out, blue_out = Lines(red), Lines(blue)
+        blue_out.wait_for("step 1")
+        # blue's second life starts up while blue flies (seconds on a busy machine) and
+        # tries to join until the server has dropped blue, so red, flying alone once blue
+        # is dropped, cannot finish before blue is back
+        again = client(address, "s", "blue", 1, 300, tmp_path / "blue2.npy", rejoin=True)
+        procs.append(again)
+        again_out = Lines(again)
+        assert "already connected" in again_out.wait_for("refused")
         blue.kill()
         blue.wait()
-        # dropped after its 1 s timeout; red goes on alone
-        wait_until(lambda: "dropped team blue" in srv.log.read_text(), "blue dropped")
-        go.touch()
         # deadlines on silence: a slow lockstep passes, a hung one fails
         assert red_out.wait_for("done ") == "done 3000 team red completed", red_out.tail()
         assert "team red completed" in again_out.wait_for("done "), again_out.tail()
         assert red.wait(60) == 0 and again.wait(60) == 0
+        assert "dropped team blue" in srv.log.read_text()  # after its 1 s timeout
         assert srv.poll() is None  # the server is still serving
     finally:
         for proc in procs:
