@@ -210,6 +210,8 @@ def _central(msg: dict[str, Any], width: int | None) -> None:
     if type(rows) is not list:
         raise _malformed(f"opponents must be a list of rows, got {_short(rows)}")
     seen: set[str] = set()
+    flat: list[Any] = []  # every row's values, checked at once in C (this runs every step)
+    sizes = range(1, len(NAMES) + 1) if width is None else (width,)
     for row in rows:
         if type(row) is not list or len(row) != 3:
             raise _malformed(f"an opponent row is [callsign, team, values], got {_short(row)}")
@@ -219,7 +221,13 @@ def _central(msg: dict[str, Any], width: int | None) -> None:
         if callsign in seen:
             raise _malformed(f"callsign {callsign!r} is shown twice among the opponents")
         seen.add(callsign)
-        _numbers(values, width, f"the row of {callsign!r} (the opponent view's values)")
+        if type(values) is not list or len(values) not in sizes:
+            _numbers(values, width, f"the row of {callsign!r}")  # (raises, saying why)
+        flat += values
+    if not (set(map(type, flat)) <= _NUMBERS and all(map(math.isfinite, flat))):
+        for callsign, _, values in rows:
+            _numbers(values, width, f"the row of {callsign!r} (the opponent view's values)")
+        raise AssertionError("unreachable: _numbers names the row at fault")
     _flag(msg.get("done"), "done")
     _text(msg.get("reason"), "reason")
 
