@@ -98,7 +98,7 @@ def report_build(report: BuildReport, root: Path, moved: dict[Path, Path] | None
         f"{r.seconds:.2f} s{note})"
     )
     if r.differences:
-        print(f"the dataset was kept as {r.aside} and rebuilt from the logs, as it:")
+        print(f"the old dataset was set aside as {r.aside} (not deleted) and rebuilt, because:")
         for line in r.differences[:20]:
             print(f"  {line}")
         if len(r.differences) > 20:

@@ -267,7 +267,7 @@ def _build(
             refs, digests = [], []
         else:
             shutil.copytree(root, work)
-    outcomes = {lg.path.name: LogOutcome(lg.path.name) for lg in logs}
+    outcomes = {lg.path.name: LogOutcome(lg.path.name, damaged=bool(lg.damage)) for lg in logs}
     # an episode already held, or held by an earlier log: by its frames
     holder: dict[str, EpisodeRef | int] = {}
     for k, (held, d) in enumerate(zip(refs, digests, strict=True)):

@@ -39,6 +39,7 @@ class LogOutcome:
     added: list[EpisodeRef] = field(default_factory=list)
     held: list[EpisodeRef] = field(default_factory=list)  # already in the dataset
     left_out: list[str] = field(default_factory=list)  # "what: why"
+    damaged: bool = False  # the log's damage is listed with the other logs'
 
     def __str__(self) -> str:
         took = f"{self.name}: took {len(self.added) + len(self.held)} episode(s)"
@@ -46,6 +47,8 @@ class LogOutcome:
             took += f" ({episodes_text(self.added + self.held)}; {len(self.added)} new)"
         if self.left_out:
             took += f"; left out: {'; '.join(self.left_out)}"
+        if self.damaged:
+            took += "; damaged: what it lost is listed under 'damaged logs'"
         return took
 
 

@@ -65,19 +65,61 @@ def _chunk_at(data: bytes, pos: int) -> int | None:
     return end if head + clen + 8 + records == end else None
 
 
-def _metadata_at(data: bytes, pos: int) -> bool:
-    """Whether a whole metadata record (a name, then a string map filling the body) is at
-    ``pos``."""
-    if pos + 9 + 8 > len(data) or data[pos] != METADATA:
-        return False
+# the layout of each record whose body the walk checks: fixed-size integers ("B", "H", "I",
+# "Q"), "s" a u32-prefixed string, byte array or map; the fields fill the body exactly
+# ("+": a message, whose data runs to the end of its body)
+_LAYOUTS = {
+    HEADER: "ss",
+    FOOTER: "QQI",
+    SCHEMA: "Hsss",
+    CHANNEL: "HHsss",
+    MESSAGE: "HIQQ+",
+    0x07: "Hs",  # message index
+    0x08: "QQQQsQsQQ",  # chunk index
+    0x0B: "QHIIIIQQs",  # statistics
+    METADATA: "ss",
+    0x0D: "QQs",  # metadata index
+    0x0E: "BQQ",  # summary offset
+    DATA_END: "I",
+}
+_SIZES = {"B": 1, "H": 2, "I": 4, "Q": 8}
+
+
+def _fills(data: bytes, start: int, end: int, layout: str) -> bool:
+    """Whether ``layout`` exactly fills ``data[start:end]``."""
+    at = start
+    for kind in layout:
+        if kind == "+":
+            return at <= end
+        if kind == "s":
+            if at + 4 > end:
+                return False
+            at += 4 + _U32.unpack_from(data, at)[0]
+        else:
+            at += _SIZES[kind]
+        if at > end:
+            return False
+    return at == end
+
+
+def _whole(data: bytes, pos: int) -> int | None:
+    """The end of the record at ``pos`` when it is whole: a chunk self-consistent, a record
+    of a known layout filled exactly, any other followed by a sane record header."""
+    if pos + 9 > len(data) or data[pos] not in KNOWN:
+        return None
+    if data[pos] == CHUNK:
+        return _chunk_at(data, pos)
     (length,) = _U64.unpack_from(data, pos + 1)
     end = pos + 9 + length
     if end > len(data) or length > _MAX_CHUNK:
-        return False
-    at = pos + 9 + 4 + _U32.unpack_from(data, pos + 9)[0]
-    if at + 4 > end:
-        return False
-    return at + 4 + _U32.unpack_from(data, at)[0] == end
+        return None
+    layout = _LAYOUTS.get(data[pos])
+    if layout is not None:
+        return end if _fills(data, pos + 9, end, layout) else None
+    if end + 9 > len(data):
+        return end
+    opcode, following = _RECORD.unpack_from(data, end)
+    return end if opcode in KNOWN and following <= len(data) else None
 
 
 def _next_record(data: bytes, start: int) -> int | None:
@@ -86,7 +128,7 @@ def _next_record(data: bytes, start: int) -> int | None:
     for opcode in (CHUNK, METADATA):
         pos = data.find(bytes([opcode]), start)
         while pos != -1:
-            if _chunk_at(data, pos) is not None or _metadata_at(data, pos):
+            if _whole(data, pos) is not None:
                 found.append(pos)
                 break
             pos = data.find(bytes([opcode]), pos + 1)
@@ -95,15 +137,15 @@ def _next_record(data: bytes, start: int) -> int | None:
 
 def records(data: bytes, damage: list[Damage]) -> Iterator[tuple[int, int, memoryview]]:
     """(offset, opcode, body) of every readable top-level record; what cannot be read goes
-    to ``damage``. Stops at the footer, or where the file ends (a session killed mid-write)."""
+    to ``damage``. Stops at the footer, or where the file ends (a session killed mid-write:
+    the last record runs past the end of a file that does not end in the closing magic)."""
     view = memoryview(data)
+    closed = len(data) > 2 * len(MAGIC) and data.endswith(MAGIC)
     pos = len(MAGIC)
     while pos + 9 <= len(data):
         opcode, length = _RECORD.unpack_from(data, pos)
-        end = pos + 9 + length
-        sane = opcode in KNOWN and length <= len(data)
-        whole = opcode != CHUNK or _chunk_at(data, pos) is not None
-        if sane and end <= len(data) and whole:
+        end = _whole(data, pos)
+        if end is not None:
             yield pos, opcode, view[pos + 9 : end]
             if opcode == FOOTER:
                 return
@@ -111,9 +153,9 @@ def records(data: bytes, damage: list[Damage]) -> Iterator[tuple[int, int, memor
             continue
         resume = _next_record(data, pos + 1)
         if resume is None:
-            if sane:
-                return  # cut off by the end of the file: where the writer was killed
-            damage.append(Damage(pos, len(data), "unreadable records to the end of the file"))
+            cut = opcode in KNOWN and pos + 9 + length > len(data) and not closed
+            if not cut:
+                damage.append(Damage(pos, len(data), "unreadable records to the end of the file"))
             return
         damage.append(Damage(pos, resume, f"a damaged record (opcode {opcode:#04x})"))
         pos = resume

@@ -20,6 +20,7 @@ from gymfg_il.recording.mcap_walk import (
     CHUNK,
     DATA_END,
     FOOTER,
+    MAGIC,
     MESSAGE,
     METADATA,
     Damage,
@@ -135,6 +136,8 @@ def stream(data: bytes, seen: Sorter, damage: list[Damage]) -> tuple[dict[str, A
             data_ok, data_end = data_intact(data, pos, body), pos
         elif opcode == FOOTER:
             finished, summary_ok = True, summary_intact(data, pos, body)
+            if data[end:] != MAGIC:
+                damage.append(Damage(end, len(data), "the closing MCAP magic is damaged"))
     session = _session(maps, damage)
     # channels the first chunk declares, should it be lost: the summary's (unless its CRC
     # fails) over the writer's table
