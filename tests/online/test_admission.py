@@ -231,3 +231,34 @@ def test_a_team_holds_its_name_and_callsigns_only_while_it_reports(serve, case):
         squatter.leave_silently()
         red.close(0)
         ctx.term()
+
+
+@pytest.mark.parametrize("on_stall", ["pause", "end"])
+def test_a_stalled_team_others_wait_for_pauses_or_ends_as_configured(serve, on_stall):
+    """Where another team waits for its report, a silent team is kept while the waiting team
+    is paused (and answers the server's waits), or the simulation ends; never dropped."""
+    address, _, log = serve("--mode", "open", "--on-stall", on_stall, "--timeout", "0.5")
+    ctx = zmq.Context()
+    red, blue = dealer(ctx, address), dealer(ctx, address)
+    try:
+        for sock, name in ((red, "red"), (blue, "blue")):
+            assert join(sock, name, {f"{name}-1": "c172p"})["type"] == "welcome"
+        report(red, "red", ["red-1"])
+        assert decode(red.recv(), "server")["tick"] == 0  # red alone
+        report(blue, "blue", ["blue-1"])  # blue joins; red falls silent, blue waits for it
+        waits = 0
+        while (reply := decode(blue.recv(), "server"))["type"] == "wait":
+            assert reply["reason"] == "paused: waiting for red"
+            blue.send(encode({"type": "alive", "team": "blue"}))
+            waits += 1
+            if waits == 8:  # 8 x the wait interval (0.125 s): red is silent beyond 0.5 s
+                report(red, "red", ["red-1"])  # red comes back: the lockstep goes on
+        assert reply["type"] == "central" and reply["opponents"][0][0] == "red-1"
+        if on_stall == "pause":
+            assert waits == 8 and "dropped team" not in log.read_text()
+        else:
+            assert waits == 0 and reply["done"] and reply["reason"] == "team red stopped reporting"
+    finally:
+        red.close(0)
+        blue.close(0)
+        ctx.term()
