@@ -11,9 +11,9 @@ from pathlib import Path
 from gymfg_il.collectors.session import DATASET, LOGS
 from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs, dataset_refs, unrebuildable
 from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
-from gymfg_il.datasets.gather import set_aside
+from gymfg_il.datasets.gather import read_logs, set_aside
 from gymfg_il.errors import ConfigError
-from gymfg_il.recording.reader import EmptyLog, read_log
+from gymfg_il.recording.reader import EmptyLog, Log, read_log
 from gymfg_il.recording.replay import replay_episode, world_for
 
 
@@ -126,12 +126,19 @@ def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
     if not paths:
         raise ConfigError(f"no logs under {target}")
     failures = 0
-    logs = []
-    for path in paths:
+    logs: list[Log] = []
+    if target.is_dir():  # a folder's unreadable files (a FIFO, a link, junk) are named
+        logs, empty, unreadable = read_logs(paths)
+        for name in empty:
+            print(f"skipped {name}: a session stopped before writing anything to it")
+        for u in unreadable:
+            print(f"could not read {u.path.name}: {u.why}", file=sys.stderr)
+        failures += len(unreadable)
+    else:
         try:
-            logs.append(read_log(path))
+            logs.append(read_log(target))
         except EmptyLog:
-            print(f"skipped {path.name}: a session stopped before writing anything to it")
+            print(f"skipped {target.name}: a session stopped before writing anything to it")
     for lg in logs:
         for note in lg.damage:
             print(f"{lg.path.name}: could not read {note}", file=sys.stderr)

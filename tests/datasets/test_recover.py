@@ -175,13 +175,20 @@ def test_unreadable_logs_are_set_aside_and_the_rest_rebuilt(copy, tmp_path):
     (logs / "outside.mcap").symlink_to(outside)
     shutil.rmtree(copy / "dataset")
     env = {**os.environ, "HF_HUB_OFFLINE": "1"}
-    run = subprocess.run(
-        [sys.executable, "-m", "gymfg_il.collect", "recover", str(copy)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=600,  # a deadline for the FIFO's old hang, not a timing
-    )
+
+    def collect_(*argv):
+        return subprocess.run(
+            [sys.executable, "-m", "gymfg_il.collect", *argv],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=600,  # a deadline for the FIFO's old hang, not a timing
+        )
+
+    replayed = collect_("replay", str(copy))  # names them too, and re-flies the good log
+    assert replayed.returncode == 1 and "could not read fifo.mcap" in replayed.stderr
+    assert replayed.stdout.count("identical") == EPISODES
+    run = collect_("recover", str(copy))
     assert run.returncode == 1, run.stderr
     text = run.stdout + run.stderr
     assert f"{EPISODES} episodes (+{EPISODES}" in text
@@ -192,11 +199,5 @@ def test_unreadable_logs_are_set_aside_and_the_rest_rebuilt(copy, tmp_path):
     assert "not an MCAP file" in text and "a FIFO" in text and "symbolic link" in text
     assert log.exists() and outside.exists()  # nothing deleted, nothing outside touched
     # the next recover finds a clean folder
-    again = subprocess.run(
-        [sys.executable, "-m", "gymfg_il.collect", "recover", str(copy)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=600,
-    )
+    again = collect_("recover", str(copy))
     assert again.returncode == 0, again.stderr
