@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.datasets.episode_logs import log_name_problem
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.names import BadNameError, name_problem
@@ -173,7 +174,12 @@ class _FlownActions:
         """(the flown actions, whether they are the exact ones: from the log)."""
         name, index = meta.get("gymfg/log"), meta.get("gymfg/log_episode")
         callsign = meta.get("gymfg/callsign", "ego")
-        if self.logs is not None and name and (self.logs / name).is_file():
+        if (
+            self.logs is not None
+            and isinstance(name, str)
+            and log_name_problem(name) is None  # a file name in logs/, never a path
+            and (self.logs / name).is_file()
+        ):
             from gymfg_il.recording.reader import read_log
 
             if name not in self._read:
