@@ -5,8 +5,9 @@ reads every frame of the data files (their page checksums verified, where the bu
 them) and compares each episode with the log episode it names, column by column as the
 builder stores it (float32 state, action and reward, the done and intervention flags, the
 environment state), and LeRobot's bookkeeping (episode, frame and global indexes, timestamps,
-task index) with what the episode table says. An episode no log holds is checked for its
-bookkeeping alone. Two episodes with the same frames, both of logs, are one episode twice.
+task index) with what the episode table says. An episode no log holds is not checked: a
+rebuild could not replace it. Two episodes with the same frames, both of logs, are one
+episode twice.
 """
 
 from __future__ import annotations
@@ -120,13 +121,15 @@ def differences(
     seen: dict[str, int] = {}
     for e in range(len(episodes)):
         row = episodes[e]
-        name = f"dataset episode {e}"
         ref = refs[e] if e < len(refs) else None
+        name = f"dataset episode {e} ({ref})"
         rows = where.pop(e, np.zeros(0, dtype=np.int64))
+        digests.append(digest(frames["observation.state"][rows], frames["action"][rows]))
+        if ref is None or ref not in logged:
+            continue  # nothing could replace it: left as it is
         n, start = int(row["length"]), int(row["dataset_from_index"])
         if len(rows) != n or int(row["dataset_to_index"]) != start + n:
             problems.append(f"{name}: the data files hold {len(rows)} frames, its table {n}")
-            digests.append("")
             continue
         steps = np.arange(n)
         task = frames["task_index"][rows]
@@ -139,25 +142,18 @@ def differences(
             "task_index": bool((task == task[0]).all() and 0 <= task[0] < tasks),
         }
         problems += [
-            f"{name}: its {k} column is not what it was written as"
-            for k, ok in book.items()
-            if not ok
+            f"{name}: its {k} column is not as written" for k, ok in book.items() if not ok
         ]
-        digests.append(digest(frames["observation.state"][rows], frames["action"][rows]))
-        if ref is None or ref not in logged:
-            continue
         twin = seen.setdefault(digests[-1], e)
         if twin != e:
-            problems.append(f"{name} ({ref}): the same episode as dataset episode {twin}")
+            problems.append(f"{name}: the same episode as dataset episode {twin}")
         for key, want in _expected(logged[ref], features).items():
             have = frames[key][rows]
             if have.shape != want.shape:
-                problems.append(
-                    f"{name} ({ref}): {key} has shape {have.shape}, its log {want.shape}"
-                )
+                problems.append(f"{name}: {key} has shape {have.shape}, its log {want.shape}")
             elif not np.array_equal(have, want, equal_nan=have.dtype.kind == "f"):
                 at = _first_difference(have, want)
-                problems.append(f"{name} ({ref}): {key} differs from its log at frame {at}")
+                problems.append(f"{name}: {key} differs from its log at frame {at}")
     if where:
         problems.append(
             f"the data files hold frames of episodes {sorted(where)[:5]} no table lists"
