@@ -73,7 +73,11 @@ class OnlineEnv:
 
     ``reset`` and ``step`` return what ``OfflineEnv`` returns; ``truncated`` also becomes True
     when the server ends the simulation (in a k-fixed simulation, when any team completes),
-    with ``info["server_reason"]``.
+    with ``info["server_reason"]``. A simulation that ends as it begins (a team completing at
+    its first report) makes ``reset`` join the next one; a team the server dropped (silent
+    for the server's timeout) joins again at its next report. Every reply is checked against
+    the protocol: a malformed one is a ``ServerError`` (code ``malformed``), as are refusals
+    and a silent server.
 
     With ``multiplayer``, the FlightGear aircraft heard follow the server's rows in
     ``opponent_states`` (sorted by callsign; ``info["opponent_callsigns"]`` names every row),
