@@ -103,6 +103,8 @@ def report_build(report: BuildReport, root: Path, moved: dict[Path, Path] | None
             print(f"  {line}")
         if len(r.differences) > 20:
             print(f"  ... and {len(r.differences) - 20} more")
+    if r.logs:
+        print("what each log gave:")
     for outcome in r.logs:
         print(f"  {outcome}")
     if r.skipped_incomplete:
