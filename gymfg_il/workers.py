@@ -91,6 +91,16 @@ def _seed_task[T](fn: Callable[..., T], args: tuple[Any, ...], seed: int) -> T:
     return fn(*args, seed)
 
 
+def _refused_token(err: BaseException | None) -> bool:
+    """Whether Ray's connection error came from token authentication (Ray wraps its
+    AuthenticationError in a RuntimeError's text, in a ConnectionError)."""
+    while err is not None:
+        if "InvalidAuthToken" in str(err) or type(err).__name__ == "AuthenticationError":
+            return True
+        err = err.__cause__ or err.__context__
+    return False
+
+
 class _RayTasks:
     """Episodes as Ray tasks: connected at start, disconnected (a local cluster stopped) at
     close."""
@@ -99,9 +109,11 @@ class _RayTasks:
         import os
         from pathlib import Path
 
-        # Ray 2.60's `ray start --head` turns on token authentication and keeps the token in
-        # ~/.ray/auth_token; a driver must say it uses it before Ray is imported
-        if address != "local" and (Path.home() / ".ray" / "auth_token").is_file():
+        # Ray 2.60's `ray start --head` turns on token authentication when a token is at hand
+        # (~/.ray/auth_token, or RAY_AUTH_TOKEN / RAY_AUTH_TOKEN_PATH); a driver must say it
+        # uses it before Ray is imported
+        token = any(os.environ.get(v) for v in ("RAY_AUTH_TOKEN", "RAY_AUTH_TOKEN_PATH"))
+        if address != "local" and (token or (Path.home() / ".ray" / "auth_token").is_file()):
             os.environ.setdefault("RAY_AUTH_MODE", "token")
         # Ray starts its workers at nice 15: beside any other work (a training run, a build)
         # they got what was left and flew episodes 8-10x slower than the process pool. A
@@ -123,6 +135,12 @@ class _RayTasks:
                 else:
                     ray.init(address=address, log_to_driver=False)
             except (ConnectionError, ValueError, RuntimeError) as err:
+                if _refused_token(err):
+                    raise ConfigError(
+                        f"--ray {address}: the cluster refused this process's token; give it "
+                        "the cluster's (RAY_AUTH_TOKEN_PATH=FILE, or ~/.ray/auth_token as on "
+                        "its head) with RAY_AUTH_MODE=token"
+                    ) from None
                 first = str(err).strip().splitlines()[0] if str(err).strip() else ""
                 raise ConfigError(
                     f"--ray {address}: no Ray cluster there ({first}); start one with `ray "
