@@ -243,3 +243,23 @@ def test_acmi_out_where_nothing_can_be_written(tmp_path, capsys):
     out = tmp_path / "a-file" / "x.acmi"
     assert collect.main(["export", "acmi", str(tmp_path / "s"), "--out", str(out)]) == 2
     one_error(capsys, f"--out {out}: cannot write there")
+
+
+def test_a_reader_that_goes_away_ends_the_command_quietly():
+    """``collect recover DIR | head -1`` ended in a BrokenPipeError traceback."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from gymfg_il import cli; "
+        "sys.exit(cli.run(lambda: [print('line', i) for i in range(200000)] and 0))"
+    )
+    shell = f'{sys.executable} -c "{code}" | head -1'
+    done = subprocess.run(["bash", "-c", shell], capture_output=True, text=True, timeout=300)
+    assert done.stdout == "line 0\n"
+    assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, done.stderr
+
+
+def test_recover_refuses_a_callsign_off_the_name_rule(tmp_path, capsys):
+    assert collect.main(["recover", str(tmp_path), "--callsign", "a\nb"]) == 2
+    one_error(capsys, "printable")

@@ -13,6 +13,7 @@ from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs, dataset_refs, 
 from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
 from gymfg_il.datasets.gather import read_logs, set_aside
 from gymfg_il.errors import ConfigError
+from gymfg_il.names import check_name
 from gymfg_il.recording.reader import EmptyLog, Log, read_log
 from gymfg_il.recording.replay import replay_episode, world_for
 
@@ -34,6 +35,10 @@ class RecoverConfig:
 
     dir: Path = field(metadata={"positional": True})
     callsign: list[str] = field(default_factory=list, metadata={"repeat": True})
+
+    def __post_init__(self) -> None:
+        for callsign in self.callsign:
+            check_name(callsign, "callsign")
 
 
 @dataclass
