@@ -79,6 +79,9 @@ def test_keys_typed_into_a_real_window_become_the_dataset(display, tmp_path):
         xdo(display, "mousemove", "450", "300")
         while proc.poll() is None and time.monotonic() < deadline:
             xdo(display, "key", "space")
+            # release first: a second keydown of a key X holds down is a key repeat, which
+            # pygame drops, so a Left pressed before the start cleared it was never seen again
+            xdo(display, "keyup", "Left")
             xdo(display, "keydown", "Left")
             time.sleep(0.2)
         xdo(display, "keyup", "Left")
