@@ -61,8 +61,7 @@ def test_a_flightgear_aircraft_is_an_opponent_and_a_reward_target_until_it_falls
     env = OfflineEnv(agent_hz=30, multiplayer=config)
     try:
         env.configure(team)  # the env listens from here on
-        person.send("person", "c172p", PERSON)
-        time.sleep(0.05)
+        person.send("person", "c172p", PERSON)  # on loopback, queued at the listener on send
         _, rows = env.reset(team, seed=0)
         assert rows.shape == (1, 6)
         assert rows[0] == pytest.approx(PERSON, abs=1e-4)
@@ -75,8 +74,9 @@ def test_a_flightgear_aircraft_is_an_opponent_and_a_reward_target_until_it_falls
             person.send("person", "c172p", PERSON)
             _, rows, rewards, _, _, info = env.step(action)
             assert info["opponent_callsigns"] == ["person"]
-        took = time.perf_counter() - t0
-        assert 0.25 < took < 0.6  # 9 steps at 30 Hz: real time
+        # paced to the wall clock: 9 steps at 30 Hz never take less than 0.3 s (the upper
+        # side is the machine's load, not the env's)
+        assert time.perf_counter() - t0 > 0.25
         assert seen[-1] is not None and seen[-1] == pytest.approx(PERSON, abs=1e-4)
         for _ in range(30):  # 1 s of silence: dropped after 0.5 s
             _, rows, rewards, *_, info = env.step(action)
@@ -134,8 +134,7 @@ def test_the_pettingzoo_env_shows_flightgear_aircraft_to_every_team_until_they_f
     # callsigns of 7 characters at most: FlightGear keeps no more
     env = parallel_env([red, blue], agent_hz=30, multiplayer=config)  # listens from here on
     try:
-        person.send("person", "c172p", PERSON)
-        time.sleep(0.05)
+        person.send("person", "c172p", PERSON)  # on loopback, queued at the listener on send
         obs, infos = env.reset(seed=0)
         for agent, other in (("red1", "blue1"), ("blue1", "red1")):
             assert obs[agent]["opponents"].shape == (2, 6)  # the other team, then the person
@@ -149,7 +148,7 @@ def test_the_pettingzoo_env_shows_flightgear_aircraft_to_every_team_until_they_f
             person.send("person", "c172p", PERSON)
             obs, rewards, *_, infos = env.step(dict.fromkeys(env.agents, action))
             assert infos["blue1"]["opponent_callsigns"] == ["red1", "person"]
-        assert 0.25 < time.perf_counter() - t0 < 0.6  # 9 steps at 30 Hz: real time
+        assert time.perf_counter() - t0 > 0.25  # paced to the wall clock (9 steps at 30 Hz)
         assert seen[-1] == pytest.approx(PERSON, abs=1e-4)
         for _ in range(30):  # 1 s of silence: dropped after 0.5 s
             obs, rewards, *_, infos = env.step(dict.fromkeys(env.agents, action))
@@ -158,7 +157,6 @@ def test_the_pettingzoo_env_shows_flightgear_aircraft_to_every_team_until_they_f
         assert infos["red1"]["opponent_callsigns"] == ["blue1"]
         assert seen[-1] is None and all(np.isfinite(r) for r in rewards.values())
         person.send("person", "c172p", PERSON)  # heard again: PettingZoo's own checks pass
-        time.sleep(0.05)
         parallel_api_test(env, num_cycles=20)
     finally:
         env.close()
