@@ -1,5 +1,6 @@
 """The package's layout keeps its promises: every import runs down the layers (a package
-imports only from the layers below it, and from itself), and no module is over 400 lines."""
+imports only from the layers below it, and from itself), the library never imports through
+an old path kept for users (``gymfg_il.moved``), and no module is over 400 lines."""
 
 import ast
 from pathlib import Path
@@ -10,9 +11,10 @@ ROOT = Path(__file__).resolve().parents[1] / "gymfg_il"
 
 # bottom to top; a package may import from its own layer and the ones before it
 LAYERS = [
-    {"errors", "typecheck", "names"},
+    {"errors", "typecheck", "names", "units", "moved", "agent"},
     {"aircraft", "workers"},
     {"sim"},
+    {"flightgear"},
     {"tasks"},
     {"controllers"},
     {"viz"},
@@ -38,21 +40,28 @@ def top(path: Path) -> str:
     return path.relative_to(ROOT).parts[0].removesuffix(".py")
 
 
-def imported(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text())
+def imported_modules(path: Path) -> set[str]:
+    """Every dotted name an import of ``path`` may load: ``from a.b import c`` gives both
+    ``a.b`` and ``a.b.c`` (``c`` may be a module)."""
     found = set()
-    for node in ast.walk(tree):
+    for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            names = [node.module]
+            found.add(node.module)
+            found.update(f"{node.module}.{a.name}" for a in node.names)
         elif isinstance(node, ast.Import):
-            names = [a.name for a in node.names]
-        else:
-            continue
-        for name in names:
-            parts = name.split(".")
-            if parts[0] == "gymfg_il" and len(parts) > 1:
-                found.add(parts[1])
+            found.update(a.name for a in node.names)
     return found
+
+
+def imported(path: Path) -> set[str]:
+    """The top-level packages and modules of gymfg_il that ``path`` imports from."""
+    parts = (name.split(".") for name in imported_modules(path))
+    return {p[1] for p in parts if p[0] == "gymfg_il" and len(p) > 1}
+
+
+def dotted(path: Path) -> str:
+    parts = path.relative_to(ROOT.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
 def test_every_package_has_a_layer():
@@ -65,6 +74,32 @@ def test_imports_run_down_the_layers(path):
     own = LAYER[top(path)]
     upward = sorted(name for name in imported(path) if LAYER.get(name, -1) > own)
     assert not upward, f"{path.relative_to(ROOT)} (layer {own}) imports {upward} from above"
+
+
+def old_paths() -> set[str]:
+    """The modules kept only so that imports users write keep working (tiny shims)."""
+    return {
+        dotted(p)
+        for p in modules()
+        if "gymfg_il.moved" in imported_modules(p) and p.stem != "__main__"
+    }
+
+
+def test_the_old_paths_are_the_ones_users_were_told_about():
+    assert old_paths() == {
+        "gymfg_il.controllers.agent",
+        "gymfg_il.manual.cockpit",
+        "gymfg_il.viz.flightgear",
+        "gymfg_il.viz.multiplayer",
+        "gymfg_il.viz.netfdm",
+        "gymfg_il.viz.peers",
+    }
+
+
+@pytest.mark.parametrize("path", modules(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_the_library_never_imports_through_an_old_path(path):
+    through = sorted(imported_modules(path) & old_paths())
+    assert not through, f"{path.relative_to(ROOT)} imports {through}: use their new home"
 
 
 def test_no_module_is_over_400_lines():

@@ -67,7 +67,7 @@ class ReplayConfig:
         log: an .mcap log, or a session folder (all its logs).
         episode: only this episode (default: all completed).
         view: also show the replay in FlightGear listening on this UDP port (repeatable;
-            real time; see gymfg_il.viz.flightgear).
+            real time; see gymfg_il.flightgear.launcher).
     """
 
     log: Path = field(metadata={"positional": True})

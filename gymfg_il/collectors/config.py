@@ -65,7 +65,7 @@ class CollectConfig:
         assist: manual only: ``controller`` or a policy folder that flies until the person
             takes over (T); the person's frames are flagged as interventions.
         view: manual only: UDP ports of FlightGear out-the-window views (repeatable; see
-            gymfg_il.viz.flightgear).
+            gymfg_il.flightgear.launcher).
         pilot: manual only: who is at the controls: a person, or the synthetic pilot (a model
             of a person flying through the same keyboard, joystick or mouse; it runs
             headless and as fast as the machine allows; its episodes are source=synthetic).

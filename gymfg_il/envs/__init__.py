@@ -4,8 +4,8 @@ and the flight spec that describes what any of them flies.
 Modules: ``team`` (Team), ``world`` (the lockstep of every aircraft), ``config`` (EnvConfig),
 ``offline`` (OfflineEnv), ``single`` (AircraftEnv, gymnasium), ``multiagent`` (the PettingZoo
 ParallelEnv), ``flight`` (FlightSpec), ``roster`` (its aircraft and teams), ``scenarios``
-(joint starts), ``display`` (FlightGear views), ``actions`` (the action contract),
-``registration`` (gymnasium ids).
+(joint starts), ``actions`` (the action contract), ``registration`` (gymnasium ids). A world's
+FlightGear views are ``gymfg_il.flightgear.display``.
 """
 
 from gymfg_il.envs.config import EnvConfig

@@ -8,11 +8,11 @@ from dataclasses import dataclass, field
 
 from gymfg_il.envs.scenarios import Scenario
 from gymfg_il.errors import ConfigError
+from gymfg_il.flightgear.multiplayer import port_problem
+from gymfg_il.flightgear.peers import MultiplayerConfig
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, ORIENTATION, POSITION, indices
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
 from gymfg_il.sim.weather import Weather
-from gymfg_il.viz.multiplayer import port_problem
-from gymfg_il.viz.peers import MultiplayerConfig
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,7 @@ class EnvConfig:
             (``FlightGear(multiplayer_port=...)``): every other aircraft of the simulation,
             opponents of an online client included, is sent there and appears in the view.
         weather: turbulence and wind (``sim.weather.Weather``), seeded per episode.
-        multiplayer: FlightGear multiplayer (``viz.peers.MultiplayerConfig``): every
+        multiplayer: FlightGear multiplayer (``flightgear.peers.MultiplayerConfig``): every
             FlightGear aircraft heard on its port is an opponent (position and orientation
             only), our aircraft are sent to its ``send_to`` addresses, and the simulation
             paces itself to real time, FlightGear's clock.

@@ -29,9 +29,9 @@ from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import World
 from gymfg_il.errors import ActionError, EnvStateError
+from gymfg_il.flightgear.peers import MultiplayerConfig
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW, BY_NAME
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
-from gymfg_il.viz.peers import MultiplayerConfig
 
 
 class GymFGParallelEnv(ParallelEnv):

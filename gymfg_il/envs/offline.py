@@ -18,18 +18,18 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.controllers.agent import Agent
+from gymfg_il.agent import Agent
 from gymfg_il.envs.actions import Controls, controls, team_controls
 from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.scenarios import Scenario
 from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import SimPool, World
 from gymfg_il.errors import ConfigError, EnvStateError
+from gymfg_il.flightgear.peers import MultiplayerConfig
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
 from gymfg_il.sim.weather import Weather
-from gymfg_il.viz.peers import MultiplayerConfig
 
 TeamState = list[np.ndarray]
 

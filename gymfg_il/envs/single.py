@@ -41,7 +41,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         sim_hz: JSBSim rate (Hz).
         episode_time_s: episode length; reaching it sets ``truncated`` (default: the task's
             own, 90 s for most tasks).
-        views: UDP ports of FlightGear views of the aircraft (``viz.flightgear``); with a view
+        views: UDP ports of FlightGear views of the aircraft (``flightgear.launcher``); with a view
             attached the env runs at real time.
         turbulence, wind_kt, wind_from_deg: the weather (``sim.weather``): JSBSim's
             turbulence (none, light, moderate, severe) and a steady wind, seeded per episode.

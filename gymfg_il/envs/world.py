@@ -20,16 +20,16 @@ import numpy as np
 from gymfg_il.controllers.lead import LeadPilot
 from gymfg_il.envs.actions import Controls
 from gymfg_il.envs.config import EnvConfig
-from gymfg_il.envs.display import Displays
 from gymfg_il.envs.slots import SimPool, Slot
 from gymfg_il.envs.team import Team, build_task, check_unique
 from gymfg_il.errors import ConfigError
+from gymfg_il.flightgear.display import Displays
+from gymfg_il.flightgear.multiplayer import CALLSIGN_BYTES
+from gymfg_il.flightgear.peers import MultiplayerLink, Peer
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import ORIENTATION, POSITION, StateView, indices
 from gymfg_il.sim.timing import episode_steps
 from gymfg_il.tasks.base import diverged
-from gymfg_il.viz.multiplayer import CALLSIGN_BYTES
-from gymfg_il.viz.peers import MultiplayerLink, Peer
 
 log = logging.getLogger(__name__)
 

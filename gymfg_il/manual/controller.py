@@ -3,7 +3,7 @@
 The session loop hands it each frame's pygame events (``handle``); ``act`` returns the
 controls as they stand. Keyboard and joystick state is built from events (KEYDOWN/KEYUP,
 JOYAXISMOTION, ...), never from polling, so injected events drive it exactly like real ones.
-The ``flightgear`` device reads FlightGear's controls stream instead (``manual.cockpit``),
+The ``flightgear`` device reads FlightGear's controls stream instead (``flightgear.cockpit``),
 at every ``handle`` and ``act``.
 
 The stick's neutral is the episode's start controls (``start_from``: a trimmed start's trim),
@@ -31,7 +31,7 @@ from gymfg_il.manual.bindings import (
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
 
 if TYPE_CHECKING:
-    from gymfg_il.manual.cockpit import CockpitReceiver
+    from gymfg_il.flightgear.cockpit import CockpitReceiver
 
 DEVICES = ("keyboard", "mouse", "joystick", "flightgear")
 
@@ -82,7 +82,7 @@ class ManualController:
         self._key_of = self._index_keys()
         self.cockpit: CockpitReceiver | None = None
         if device == "flightgear":
-            from gymfg_il.manual.cockpit import CockpitReceiver
+            from gymfg_il.flightgear.cockpit import CockpitReceiver
 
             fg = flightgear or FlightGearBindings()
             self.cockpit = CockpitReceiver(fg.port, fg.host)

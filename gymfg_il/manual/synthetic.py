@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.controllers.agent import Agent
+from gymfg_il.agent import Agent
 from gymfg_il.errors import ConfigError
 from gymfg_il.manual.bindings import (
     JoystickBindings,

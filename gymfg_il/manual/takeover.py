@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gymfg_il.controllers.agent import Agent
+from gymfg_il.agent import Agent
 from gymfg_il.manual.controller import ManualController
 
 

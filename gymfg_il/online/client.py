@@ -21,11 +21,11 @@ from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import SimPool, World
 from gymfg_il.errors import ConfigError, EnvStateError
+from gymfg_il.flightgear.peers import MultiplayerConfig
 from gymfg_il.online.link import ServerLink
 from gymfg_il.online.protocol import ServerError, printable
 from gymfg_il.sim.properties import ORIENTATION, POSITION
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
-from gymfg_il.viz.peers import MultiplayerConfig
 
 _LEAVE_LINGER_MS = 250
 _FORGOTTEN = ("unknown", "dropped")  # error codes of a server that no longer has the team

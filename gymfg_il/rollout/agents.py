@@ -8,7 +8,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
-from gymfg_il.controllers.agent import Agent
+from gymfg_il.agent import Agent
 from gymfg_il.envs.single import AircraftEnv
 
 

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.controllers.agent import Agent
+from gymfg_il.agent import Agent
 from gymfg_il.envs.actions import clip
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.envs.team import Team

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from gymfg_il import Team
+from gymfg_il.agent import ConstantAgent
 from gymfg_il.aircraft import c172p, f15
-from gymfg_il.controllers.agent import ConstantAgent
 from gymfg_il.envs import OfflineEnv
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.tasks import DummyTask

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from gymfg_il import Team
+from gymfg_il.agent import ConstantAgent
 from gymfg_il.aircraft import c172p, f15
-from gymfg_il.controllers.agent import ConstantAgent
 from gymfg_il.envs import AircraftEnv, FlightSpec, OfflineEnv
 from gymfg_il.envs.scenarios import formation
 from gymfg_il.errors import ConfigError, DuplicateNameError, RateError, UnknownAircraftError

@@ -1,8 +1,7 @@
 """FlightGear aircraft heard over multiplayer are opponents of the offline env, without a
-FlightGear: a sender on this machine plays FlightGear's part (``tests/viz/test_flightgear_mp.py``
-does the same against a real one)."""
+FlightGear: a sender on this machine plays FlightGear's part
+(``tests/flightgear/test_flightgear_mp.py`` does the same against a real one)."""
 
-import os
 import socket
 import time
 
@@ -13,33 +12,20 @@ from gymfg_il import Team
 from gymfg_il.aircraft import c172p
 from gymfg_il.envs import OfflineEnv
 from gymfg_il.errors import ConfigError
+from gymfg_il.flightgear import multiplayer as mp
+from gymfg_il.flightgear import peers
+from gymfg_il.flightgear.peers import MultiplayerConfig
 from gymfg_il.tasks import DummyTask
-from gymfg_il.viz import multiplayer as mp
-from gymfg_il.viz import peers
-from gymfg_il.viz.peers import MultiplayerConfig
 
 pytestmark = pytest.mark.network
-
-
-def free_udp_ports(n):
-    """``n`` free UDP ports FlightGear could store (below 32768)."""
-    found = []
-    for port in range(23000 + os.getpid() % 8000, 32000):
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-            try:
-                s.bind(("127.0.0.1", port))
-            except OSError:
-                continue
-        found.append(port)
-        if len(found) == n:
-            return found
-    raise RuntimeError("no free UDP ports below 32000")
 
 
 PERSON = (37.62, -122.37, 3000.0, 20.0, 3.0, 280.0)
 
 
-def test_a_flightgear_aircraft_is_an_opponent_and_a_reward_target_until_it_falls_silent():
+def test_a_flightgear_aircraft_is_an_opponent_and_a_reward_target_until_it_falls_silent(
+    free_udp_ports,
+):
     listen, fg_in = free_udp_ports(2)
     seen = []
 
@@ -88,7 +74,7 @@ def test_a_flightgear_aircraft_is_an_opponent_and_a_reward_target_until_it_falls
         fg.close()
 
 
-def test_flightgear_opponents_show_only_position_and_orientation():
+def test_flightgear_opponents_show_only_position_and_orientation(free_udp_ports):
     with pytest.raises(ConfigError, match="FlightGear aircraft show only"):
         OfflineEnv(
             multiplayer=MultiplayerConfig(listen_port=free_udp_ports(1)[0]),
@@ -96,7 +82,7 @@ def test_flightgear_opponents_show_only_position_and_orientation():
         )
 
 
-def test_a_taken_port_is_a_config_error_naming_it():
+def test_a_taken_port_is_a_config_error_naming_it(free_udp_ports):
     port = free_udp_ports(1)[0]
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as taken:
         taken.bind(("127.0.0.1", port))
@@ -105,7 +91,9 @@ def test_a_taken_port_is_a_config_error_naming_it():
             env.configure(Team("blue", [(c172p("ego"), DummyTask)]))
 
 
-def test_the_pettingzoo_env_shows_flightgear_aircraft_to_every_team_until_they_fall_silent():
+def test_the_pettingzoo_env_shows_flightgear_aircraft_to_every_team_until_they_fall_silent(
+    free_udp_ports,
+):
     from pettingzoo.test import parallel_api_test
 
     from gymfg_il.aircraft import f15

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from gymfg_il import Team
+from gymfg_il.agent import ConstantAgent, RandomAgent
 from gymfg_il.aircraft import a320, c172p, f15
-from gymfg_il.controllers.agent import ConstantAgent, RandomAgent
 from gymfg_il.controllers.autopilot import controller_for
 from gymfg_il.envs import OfflineEnv
 from gymfg_il.envs.scenarios import formation, head_on_merge

@@ -1,8 +1,8 @@
 import pytest
 
 from gymfg_il import Team
+from gymfg_il.agent import ConstantAgent
 from gymfg_il.aircraft import c172p, f15
-from gymfg_il.controllers.agent import ConstantAgent
 from gymfg_il.envs import OfflineEnv
 from gymfg_il.errors import ConfigError, DuplicateNameError
 from gymfg_il.tasks import DummyTask

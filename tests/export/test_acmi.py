@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from gymfg_il import Team, collect
+from gymfg_il.agent import RandomAgent
 from gymfg_il.aircraft import c172p, f15
-from gymfg_il.controllers.agent import RandomAgent
 from gymfg_il.envs import OfflineEnv
 from gymfg_il.envs.scenarios import head_on_merge
 from gymfg_il.errors import ConfigError, GymFGError

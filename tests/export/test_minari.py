@@ -110,9 +110,9 @@ def test_what_cannot_be_exported_says_why(noisy, tmp_path):
 
 def test_a_team_run_is_refused_by_name(tmp_path):
     from gymfg_il import Team
+    from gymfg_il.agent import RandomAgent
     from gymfg_il.aircraft import c172p
     from gymfg_il.collectors.commands import recover
-    from gymfg_il.controllers.agent import RandomAgent
     from gymfg_il.envs import OfflineEnv
     from gymfg_il.recording.recorder import Recorder
     from gymfg_il.tasks import ReachStaticTargetAltitudeTask

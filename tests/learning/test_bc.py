@@ -3,7 +3,7 @@ import json
 import numpy as np
 import pytest
 
-from gymfg_il.controllers.agent import ConstantAgent
+from gymfg_il.agent import ConstantAgent
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.errors import ConfigError
 from gymfg_il.evaluation.trace import trace_of

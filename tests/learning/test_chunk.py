@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from gymfg_il.controllers.agent import ConstantAgent
+from gymfg_il.agent import ConstantAgent
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.evaluation.trace import trace_of
 from gymfg_il.learning.bc import TrainConfig, train_bc

@@ -1,7 +1,6 @@
 """A real window under Xvfb, real key presses from xdotool: the person's keys reach the data."""
 
 import os
-import select
 import shutil
 import subprocess
 import sys
@@ -16,28 +15,12 @@ DEADLINE_S = 180  # a loaded 2-core machine is slow; only a failure waits this l
 
 
 @pytest.fixture
-def display():
-    """An X server of our own: Xvfb picks a free display and says which (-displayfd), so a
-    display another test or person runs is never shared."""
+def display(xvfb):
+    """An X server of our own (tests/conftest.py), with xdotool to type into it."""
     if NEEDED:
         pytest.skip(f"needs {', '.join(NEEDED)} (Debian: apt-get install xvfb xdotool)")
-    read, write = os.pipe()
-    server = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
-        pass_fds=(write,),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    os.close(write)
-    try:
-        ready, _, _ = select.select([read], [], [], DEADLINE_S)  # written once it accepts
-        number = os.read(read, 64).decode().strip() if ready else ""
-        assert number.isdigit(), "Xvfb never said which display it serves"
-        yield f":{number}"
-    finally:
-        os.close(read)
-        server.terminate()
-        server.wait(30)
+    with xvfb("1024x768x24") as display:
+        yield display
 
 
 def xdo(display, *args):

@@ -35,3 +35,16 @@ def serve(tmp_path):
     for proc in procs:
         proc.terminate()
         proc.wait(10)
+
+
+@pytest.fixture
+def server(serve):
+    """``serve``, answering (address, process) with ``process.log``: the server's stderr,
+    its log."""
+
+    def start(*options):
+        address, proc, log = serve(*options)
+        proc.log = log
+        return address, proc
+
+    return start

@@ -3,8 +3,11 @@ saves its states per step (``python run_team.py ADDRESS TOKEN TEAM SEED SECONDS 
 [rejoin]]``; with ``rejoin``, it keeps trying to join while the server says the team is
 connected: a team coming back as soon as the server has dropped its killed self)."""
 
+import os
+import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -42,6 +45,28 @@ def teams(seconds: float) -> dict[str, Team]:
             "blue", [(f15("blue-1"), ReachStaticTargetHeadingTask)], episode_time_s=seconds
         ),
     }
+
+
+def start(address, token, team, seed, seconds, out, spin_us=1000, rejoin=False):
+    """This script as a team's client process, its output piped; with ``rejoin``, it keeps
+    trying to join while the server says the team is connected."""
+    return subprocess.Popen(
+        [
+            sys.executable,
+            str(Path(__file__)),
+            address,
+            token,
+            team,
+            str(seed),
+            str(seconds),
+            str(out),
+            str(spin_us),
+            *(["rejoin"] if rejoin else []),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
 
 
 def pilots(env, team):

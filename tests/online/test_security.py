@@ -18,6 +18,7 @@ from gymfg_il.tasks import DummyTask
 
 pytestmark = pytest.mark.network
 sys.path.insert(0, str(Path(__file__).parent))
+import run_team  # noqa: E402
 from waiting import wait_until  # noqa: E402
 
 
@@ -191,3 +192,31 @@ def test_a_team_completing_at_its_first_report_ends_only_that_simulation(serve):
     for thread in (red, blue):
         thread.join(120)
     assert out == {"red": 3, "blue": 3}
+
+
+def test_wrong_token_and_foreign_aircraft_are_refused(server):
+    address, _ = server("--mode", "open", "--team", "red:r3d", "--team", "blue:blu3")
+    teams = run_team.teams(3)
+    with pytest.raises(ServerError, match="unauthorised"):
+        OnlineEnv(address, token="guess", timeout_s=5).reset(teams["red"], seed=0)
+    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock.connect(address)
+    sock.send(
+        encode({"type": "join", "team": "red", "token": "r3d", "aircraft": {"red-1": "c172p"}})
+    )
+    assert decode(sock.recv(), "server")["type"] == "welcome"
+    state = [0.0] * 26
+    sock.send(
+        encode(
+            {
+                "type": "report",
+                "team": "red",
+                "token": "r3d",
+                "states": {"blue-1": state},
+                "done": False,
+            }
+        )
+    )
+    reply = decode(sock.recv(), "server")
+    assert reply["type"] == "error" and reply["code"] == "forbidden"
+    sock.close(0)

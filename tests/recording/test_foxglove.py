@@ -12,10 +12,10 @@ import pytest
 from mcap.reader import make_reader
 
 from gymfg_il import Team
+from gymfg_il.agent import ConstantAgent
 from gymfg_il.aircraft import c172p, f15
 from gymfg_il.collectors.autopilot import record_autopilot
 from gymfg_il.collectors.config import CollectConfig
-from gymfg_il.controllers.agent import ConstantAgent
 from gymfg_il.envs import OfflineEnv
 from gymfg_il.envs.scenarios import head_on_merge
 from gymfg_il.recording import foxglove

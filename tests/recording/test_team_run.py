@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from gymfg_il import Team
+from gymfg_il.agent import RandomAgent
 from gymfg_il.aircraft import c172p, f15
 from gymfg_il.collectors.commands import recover, replay
-from gymfg_il.controllers.agent import RandomAgent
 from gymfg_il.controllers.autopilot import controller_for
 from gymfg_il.envs import OfflineEnv
 from gymfg_il.envs.scenarios import head_on_merge

@@ -170,8 +170,8 @@ def test_a_diverged_opponent_is_never_shown_as_nan():
     """Another team's aircraft that diverges is seen (opponent rows, reward targets) at its
     last flown state as it ends, then absent, so a reward aimed at it stays finite."""
     from gymfg_il import Team
+    from gymfg_il.agent import ConstantAgent
     from gymfg_il.aircraft import f15
-    from gymfg_il.controllers.agent import ConstantAgent
     from gymfg_il.envs import OfflineEnv
     from gymfg_il.tasks import DummyTask
 

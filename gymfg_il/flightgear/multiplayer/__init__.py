@@ -1,6 +1,6 @@
 """Other aircraft in a FlightGear view: FlightGear's multiplayer position message.
 
-A view follows one aircraft through the native-fdm stream (``viz.netfdm``). The simulation's
+A view follows one aircraft through the native-fdm stream (``netfdm``). The simulation's
 other aircraft reach it as multiplayer traffic: one position message per aircraft and step,
 sent over UDP to the port the view listens on (``fgfs --multiplay=in,HZ,127.0.0.1,PORT``,
 which ``FlightGear(multiplayer_port=...)`` adds). FlightGear then lists each of them under
@@ -25,6 +25,7 @@ import time
 from collections.abc import Sequence
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.units import DEG_TO_RAD, FT_TO_M
 
 MAGIC = 0x46474653  # "FGFS"
 PROTOCOL = 0x00010001
@@ -57,24 +58,22 @@ MODELS = {
 }
 _FALLBACK = "Aircraft/ufo/Models/ufo.xml"
 
-_A = 6378137.0  # WGS84
-_E2 = (1 / 298.257223563) * (2 - 1 / 298.257223563)
-_FT = 0.3048
-_D2R = math.pi / 180.0
+WGS84_A = 6378137.0  # semi-major axis, m
+WGS84_E2 = (1 / 298.257223563) * (2 - 1 / 298.257223563)  # first eccentricity squared
 # FlightGear turns degrees into radians for its multiplayer position with a float32 constant
 # (SimGear's SG_DEGREES_TO_RADIANS), 7.7e-9 short of pi/180: a 9 cm shift at San Francisco.
 # Positions use its constant both ways, so what FlightGear sends decodes to what it shows.
-FG_D2R: float = struct.unpack("f", struct.pack("f", _D2R))[0]
+FG_D2R: float = struct.unpack("f", struct.pack("f", DEG_TO_RAD))[0]
 
 
 def ecef(lat_deg: float, lon_deg: float, altitude_ft: float) -> tuple[float, float, float]:
     """Earth-centred, earth-fixed position (m) of a WGS84 geodetic position, as FlightGear
     computes it (``FG_D2R``)."""
-    lat, lon, h = lat_deg * FG_D2R, lon_deg * FG_D2R, altitude_ft * _FT
+    lat, lon, h = lat_deg * FG_D2R, lon_deg * FG_D2R, altitude_ft * FT_TO_M
     s = math.sin(lat)
-    n = _A / math.sqrt(1.0 - _E2 * s * s)
+    n = WGS84_A / math.sqrt(1.0 - WGS84_E2 * s * s)
     c = (n + h) * math.cos(lat)
-    return c * math.cos(lon), c * math.sin(lon), (n * (1.0 - _E2) + h) * s
+    return c * math.cos(lon), c * math.sin(lon), (n * (1.0 - WGS84_E2) + h) * s
 
 
 Quat = tuple[float, float, float, float]  # w, x, y, z
@@ -119,8 +118,8 @@ def orientation(
 ) -> tuple[float, float, float]:
     """The body attitude in the ECEF frame as an angle-axis vector (radians)."""
     q = _mul(
-        _local_frame(lat_deg * _D2R, lon_deg * _D2R),
-        _euler(heading_deg * _D2R, pitch_deg * _D2R, roll_deg * _D2R),
+        _local_frame(lat_deg * DEG_TO_RAD, lon_deg * DEG_TO_RAD),
+        _euler(heading_deg * DEG_TO_RAD, pitch_deg * DEG_TO_RAD, roll_deg * DEG_TO_RAD),
     )
     w, x, y, z = q
     if w < 0:  # the shorter of the two equivalent rotations

@@ -1,4 +1,4 @@
-"""``python -m gymfg_il.viz.multiplayer listen``: is my FlightGear reaching the agents?"""
+"""``python -m gymfg_il.flightgear.multiplayer listen``: is my FlightGear reaching the agents?"""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from typing import TextIO
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.viz.peers import MultiplayerConfig, MultiplayerLink
+from gymfg_il.flightgear.peers import MultiplayerConfig, MultiplayerLink
 
 LISTEN_HELP = """Is my FlightGear reaching the agents? Listen for FlightGear multiplayer position
 messages on a UDP port and print each aircraft heard, about once a second, as one JSON line:
@@ -21,14 +21,14 @@ callsign, model, latitude_deg, longitude_deg, altitude_ft, roll_deg, pitch_deg, 
 
 Point FlightGear at it (peer to peer, no server needed; its --multiplay=in port must differ):
   fgfs --callsign=me --multiplay=out,10,127.0.0.1,5002 --multiplay=in,10,127.0.0.1,5003
-  python -m gymfg_il.viz.multiplayer listen --port 5002 --seconds 30
+  python -m gymfg_il.flightgear.multiplayer listen --port 5002 --seconds 30
 """
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m gymfg_il.viz.multiplayer listen``: the multiplayer diagnostic."""
+    """``python -m gymfg_il.flightgear.multiplayer listen``: the multiplayer diagnostic."""
     top = argparse.ArgumentParser(
-        prog="python -m gymfg_il.viz.multiplayer",
+        prog="python -m gymfg_il.flightgear.multiplayer",
         description="FlightGear multiplayer tools.",
     )
     sub = top.add_subparsers(dest="command", required=True)

@@ -4,7 +4,6 @@ run). Real datagrams to a real listener on loopback; crafted ones and seeded ran
 
 import json
 import math
-import os
 import socket
 import struct
 import subprocess
@@ -17,29 +16,15 @@ import pytest
 from gymfg_il import Team
 from gymfg_il.aircraft import c172p
 from gymfg_il.envs.offline import OfflineEnv
+from gymfg_il.flightgear import multiplayer as mp
+from gymfg_il.flightgear import peers
 from gymfg_il.sim.properties import BY_NAME, DEFAULT_OPPONENT_VIEW
 from gymfg_il.tasks import DummyTask
-from gymfg_il.viz import multiplayer as mp
-from gymfg_il.viz import peers
 
 pytestmark = pytest.mark.network
 
 B = 6356752.314245  # WGS84 polar radius, m
 FT = 0.3048
-
-
-def free_udp_ports(n):
-    found = []
-    for port in range(25000 + os.getpid() % 6000, 32000):
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-            try:
-                s.bind(("127.0.0.1", port))
-            except OSError:
-                continue
-        found.append(port)
-        if len(found) == n:
-            return found
-    raise RuntimeError("no free UDP ports below 32000")
 
 
 # -- geodetic on and near the axis --------------------------------------------------------
@@ -150,7 +135,7 @@ def settle(link, sent, deadline_s=30.0):
         time.sleep(0.005)
 
 
-def test_the_listener_survives_every_datagram_and_counts_each():
+def test_the_listener_survives_every_datagram_and_counts_each(free_udp_ports):
     (port,) = free_udp_ports(1)
     link = peers.MultiplayerLink(peers.MultiplayerConfig(listen_port=port, timeout_s=600))
     tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -185,7 +170,7 @@ def test_the_listener_survives_every_datagram_and_counts_each():
         link.close()
 
 
-def test_an_env_with_multiplayer_keeps_stepping_through_hostile_traffic():
+def test_an_env_with_multiplayer_keeps_stepping_through_hostile_traffic(free_udp_ports):
     listen, fg_in = free_udp_ports(2)
     config = peers.MultiplayerConfig(
         listen_port=listen, send_to=[("127.0.0.1", fg_in)], timeout_s=600
@@ -225,11 +210,11 @@ def test_an_env_with_multiplayer_keeps_stepping_through_hostile_traffic():
 # -- the listen diagnostic ------------------------------------------------------------------
 
 
-def test_listen_into_a_folder_that_cannot_exist_is_one_error_line(tmp_path):
+def test_listen_into_a_folder_that_cannot_exist_is_one_error_line(tmp_path, free_udp_ports):
     (tmp_path / "a-file").write_text("")
     (port,) = free_udp_ports(1)
     out = tmp_path / "a-file" / "heard.jsonl"
-    cmd = [sys.executable, "-m", "gymfg_il.viz.multiplayer", "listen", "--port", str(port)]
+    cmd = [sys.executable, "-m", "gymfg_il.flightgear.multiplayer", "listen", "--port", str(port)]
     proc = subprocess.run(
         [*cmd, "--seconds", "0.2", "--json", str(out)], capture_output=True, text=True, timeout=60
     )
@@ -240,16 +225,16 @@ def test_listen_into_a_folder_that_cannot_exist_is_one_error_line(tmp_path):
 
 
 @pytest.mark.parametrize("seconds", ["nan", "-1", "0"])
-def test_listen_for_no_time_is_one_error_line(seconds):
+def test_listen_for_no_time_is_one_error_line(seconds, free_udp_ports):
     (port,) = free_udp_ports(1)
-    cmd = [sys.executable, "-m", "gymfg_il.viz.multiplayer", "listen", "--port", str(port)]
+    cmd = [sys.executable, "-m", "gymfg_il.flightgear.multiplayer", "listen", "--port", str(port)]
     proc = subprocess.run([*cmd, "--seconds", seconds], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.startswith("error: ") and "--seconds" in proc.stderr, proc.stderr
     assert json.dumps(seconds)[1:-1] in proc.stderr
 
 
-def test_a_decoder_that_breaks_costs_one_datagram(monkeypatch):
+def test_a_decoder_that_breaks_costs_one_datagram(monkeypatch, free_udp_ports):
     """Whatever a future decoding bug raises, ``poll`` drops that datagram and goes on."""
     (port,) = free_udp_ports(1)
     link = peers.MultiplayerLink(peers.MultiplayerConfig(listen_port=port))

@@ -12,19 +12,17 @@ wheels (3), time, warp, visibility and 10 control-surface floats: 408 bytes.
 from __future__ import annotations
 
 import contextlib
-import math
 import socket
 import struct
 from collections.abc import Sequence
 from typing import Any
 
+from gymfg_il.units import FT_TO_M
+
 VERSION = 24
 FORMAT = ">I4x3d6f11f3f2fI4I36fI4fI3I9fIif10f"
 SIZE = struct.calcsize(FORMAT)
 assert SIZE == 408, SIZE
-
-_FT = 0.3048
-_D2R = math.pi / 180.0
 
 
 def _get(fdm: Any, prop: str, default: float = 0.0) -> float:
@@ -57,8 +55,8 @@ def pack(fdm: Any, engines: int, visibility_m: float = 20000.0) -> bytes:
         VERSION,
         g("position/long-gc-rad"),
         g("position/lat-geod-rad"),
-        g("position/h-sl-ft") * _FT,
-        g("position/h-agl-ft") * _FT,
+        g("position/h-sl-ft") * FT_TO_M,
+        g("position/h-agl-ft") * FT_TO_M,
         g("attitude/phi-rad"),
         g("attitude/theta-rad"),
         g("attitude/psi-rad"),

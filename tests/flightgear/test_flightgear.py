@@ -16,14 +16,14 @@ from gymfg_il.aircraft import c172p
 from gymfg_il.controllers.autopilot import controller_for
 from gymfg_il.envs.offline import OfflineEnv
 from gymfg_il.errors import ConfigError
+from gymfg_il.flightgear.launcher import FlightGear, FlightGearError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks import LevelFlightTask
 from gymfg_il.tasks.geometry import offset_position
-from gymfg_il.viz.flightgear import FlightGear, FlightGearError
 
 sys.path.insert(0, str(Path(__file__).parent))
-from waiting_fg import wait_flightgear_time, xvfb
+from waiting_fg import needs_flightgear, wait_flightgear_time
 
 pytestmark = pytest.mark.flightgear
 
@@ -35,21 +35,10 @@ def free_port(kind=socket.SOCK_STREAM):
 
 
 @pytest.fixture
-def display():
+def display(xvfb):
+    needs_flightgear()
     with xvfb("1024x768x24") as display:
         yield display
-
-
-def free_traffic_port():
-    """A UDP port FlightGear 2020.3 can take for multiplayer (it stores ports in 16 bits)."""
-    for port in range(20000 + os.getpid() % 5000, 32000):
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-            try:
-                s.bind(("127.0.0.1", port))
-            except OSError:
-                continue
-            return port
-    raise RuntimeError("no free UDP port below 32000")
 
 
 def wing_ahead(rng, aircraft):
@@ -62,11 +51,11 @@ def wing_ahead(rng, aircraft):
     return {ego.callsign: ic, wing.callsign: replace(ic, latitude_deg=lat, longitude_deg=lon)}
 
 
-def test_flightgear_follows_jsbsim(display, tmp_path):
+def test_flightgear_follows_jsbsim(display, tmp_path, free_udp_ports):
     """One view follows "ego" through the native-fdm stream; its wingman flies in it as
     multiplayer traffic. Both, and a healthy engine with fuel, are read back from FlightGear."""
     started = time.monotonic()
-    port, telnet, traffic = free_port(socket.SOCK_DGRAM), free_port(), free_traffic_port()
+    port, telnet, (traffic,) = free_port(socket.SOCK_DGRAM), free_port(), free_udp_ports(1)
     fg = FlightGear(port, telnet, display=display, rate_hz=30, multiplayer_port=traffic)
     try:
         fg.wait_ready()

@@ -1,5 +1,5 @@
 """The ``flightgear`` input device without FlightGear: a controls packet we encode ourselves
-(FlightGear's own stream is checked in ``tests/viz/test_flightgear_mp.py``)."""
+(FlightGear's own stream is checked in ``tests/flightgear/test_flightgear_mp.py``)."""
 
 import socket
 import struct
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.manual import cockpit
+from gymfg_il.flightgear import cockpit
 from gymfg_il.manual.bindings import FlightGearBindings
 from gymfg_il.manual.controller import ManualController
 

@@ -4,7 +4,7 @@
 and the native-fdm socket listening (``--fdm=null --native-fdm=socket,in,RATE,,PORT,udp``),
 no sound, no scenery download and a telnet property server, so a program can read FlightGear's
 own ``/position`` and ``/orientation``. With ``multiplayer_port`` the view also listens for
-multiplayer traffic, so the simulation's other aircraft appear in it (``viz.multiplayer``).
+multiplayer traffic, so the simulation's other aircraft appear in it (``multiplayer``).
 Debian/Ubuntu: ``apt-get install flightgear`` (it lands
 in /usr/games); under Xvfb it needs ``dbus-run-session`` in front, which the launcher adds when
 it is there.
@@ -15,7 +15,7 @@ writes net_fdm, so no codec of ours or theirs is involved); its ``TelnetConnecti
 once, at construction, and parses prompts, while this launcher's property client asks in
 FlightGear's ``data`` mode (one line a reply) and connects again after a failure, since
 fgfs accepts connections seconds before it answers them; and it has no multiplayer protocol
-(``viz.multiplayer`` is ours).
+(``flightgear.multiplayer`` is ours).
 """
 
 from __future__ import annotations
@@ -100,7 +100,7 @@ class FlightGear:
         multiplayer_out: int | None = None,
         callsign: str = "gymfg-view",
     ) -> None:
-        from gymfg_il.viz.multiplayer import port_problem
+        from gymfg_il.flightgear.multiplayer import port_problem
 
         problems = [port_problem(p) for p in (multiplayer_port, multiplayer_out) if p is not None]
         if any(problems):

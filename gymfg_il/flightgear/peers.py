@@ -2,7 +2,7 @@
 instances (or a multiplayer server relaying several) send, decoded, and the latest of each
 kept per callsign.
 
-``decode`` reads one message (protocol 1.1, id 7; see ``viz.multiplayer`` for the layout):
+``decode`` reads one message (protocol 1.1, id 7; see ``multiplayer`` for the layout):
 callsign, model, FlightGear's time, the ECEF position turned back into latitude, longitude
 and altitude, the ECEF angle-axis orientation turned back into roll, pitch and heading, and
 the body-frame velocities. FlightGear 2020.3 sends 893 bytes: the 232 we send ourselves plus
@@ -25,19 +25,22 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.names import name_problem
-from gymfg_il.sim.properties import BY_NAME, DEFAULT_OPPONENT_VIEW
-from gymfg_il.viz.multiplayer import (
+from gymfg_il.flightgear.multiplayer import (
     FG_D2R,
     HEADER,
     MAGIC,
     POSITION_MESSAGE,
+    WGS84_A,
+    WGS84_E2,
     Quat,
     _local_frame,
     _mul,
     pack,
     port_problem,
 )
+from gymfg_il.names import name_problem
+from gymfg_il.sim.properties import BY_NAME, DEFAULT_OPPONENT_VIEW
+from gymfg_il.units import FT_TO_M, RAD_TO_DEG, wrap_360
 
 log = logging.getLogger(__name__)
 
@@ -46,10 +49,6 @@ log = logging.getLogger(__name__)
 _BODY_HEAD = struct.Struct(">96s2d3d3f3f")
 _MIN_SIZE = HEADER.size + _BODY_HEAD.size
 
-_A = 6378137.0  # WGS84
-_E2 = (1 / 298.257223563) * (2 - 1 / 298.257223563)
-_FT = 0.3048
-_R2D = 180.0 / math.pi
 _FG_R2D = 1.0 / FG_D2R
 
 
@@ -121,17 +120,17 @@ def geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
     """
     lon = math.atan2(y, x)
     p = math.hypot(x, y)
-    lat = math.atan2(z, p * (1.0 - _E2))
+    lat = math.atan2(z, p * (1.0 - WGS84_E2))
     for _ in range(6):
         s = math.sin(lat)
-        lat = math.atan2(z + _E2 * _A / math.sqrt(1.0 - _E2 * s * s) * s, p)
+        lat = math.atan2(z + WGS84_E2 * WGS84_A / math.sqrt(1.0 - WGS84_E2 * s * s) * s, p)
     s = math.sin(lat)
-    h = p * math.cos(lat) + z * s - _A * math.sqrt(1.0 - _E2 * s * s)
+    h = p * math.cos(lat) + z * s - WGS84_A * math.sqrt(1.0 - WGS84_E2 * s * s)
     # FlightGear's degree is a float32 a little short of pi/180: keep the poles and the date
     # line where they are
     lat_deg = max(-90.0, min(90.0, lat * _FG_R2D))
     lon_deg = max(-180.0, min(180.0, lon * _FG_R2D))
-    return lat_deg, lon_deg, h / _FT
+    return lat_deg, lon_deg, h / FT_TO_M
 
 
 def attitude(
@@ -150,7 +149,7 @@ def attitude(
     roll = math.atan2(2 * (y * z + w * x), w * w - x * x - y * y + z * z)
     pitch = -math.asin(max(-1.0, min(1.0, 2 * (x * z - w * y))))
     heading = math.atan2(2 * (x * y + w * z), w * w + x * x - y * y - z * z)
-    return roll * _R2D, pitch * _R2D, (heading * _R2D) % 360.0
+    return roll * RAD_TO_DEG, pitch * RAD_TO_DEG, wrap_360(heading * RAD_TO_DEG)
 
 
 def decode(data: bytes, heard_at: float = 0.0) -> Peer:

@@ -24,14 +24,14 @@ import pytest
 from gymfg_il import Team
 from gymfg_il.aircraft import c172p
 from gymfg_il.envs.offline import OfflineEnv
+from gymfg_il.flightgear.launcher import LIGHTWEIGHT, FlightGear
+from gymfg_il.flightgear.peers import MultiplayerConfig
 from gymfg_il.manual.bindings import FlightGearBindings
 from gymfg_il.manual.controller import ManualController
 from gymfg_il.tasks import DummyTask
-from gymfg_il.viz.flightgear import LIGHTWEIGHT, FlightGear
-from gymfg_il.viz.peers import MultiplayerConfig
 
 sys.path.insert(0, str(Path(__file__).parent))
-from waiting_fg import DEADLINE_S, wait_until, xvfb
+from waiting_fg import DEADLINE_S, needs_flightgear, wait_until
 
 pytestmark = pytest.mark.flightgear
 
@@ -46,26 +46,11 @@ SHOWN = {  # FlightGear's property -> the opponent row's column
 M_PER_DEG = 111_000.0
 
 
-def free_udp_ports(n):
-    """``n`` consecutive-ish free UDP ports FlightGear can store (below 32768)."""
-    found = []
-    for port in range(24000 + os.getpid() % 7000, 32000):
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-            try:
-                s.bind(("127.0.0.1", port))
-            except OSError:
-                continue
-        found.append(port)
-        if len(found) == n:
-            return found
-    raise RuntimeError("no free UDP ports below 32000")
-
-
 class Sky:
     """The shared fgfs and the ports around it."""
 
-    def __init__(self, display):
-        self.listen, self.fg_in, self.ctrls, self.telnet = free_udp_ports(4)
+    def __init__(self, display, ports):
+        self.listen, self.fg_in, self.ctrls, self.telnet = ports
         self.fg = FlightGear(
             None,  # FlightGear flies its own c172p
             self.telnet,
@@ -124,11 +109,12 @@ class Sky:
 
 
 @pytest.fixture(scope="module")
-def sky():
+def sky(xvfb, free_udp_ports):
+    needs_flightgear()
     with xvfb("640x480x24") as display:
         sky = None
         try:
-            sky = Sky(display)
+            sky = Sky(display, free_udp_ports(4))
             yield sky
         finally:
             if sky is not None:

@@ -3,7 +3,6 @@ same traffic back from a real one)."""
 
 import json
 import math
-import os
 import signal
 import socket
 import struct
@@ -14,8 +13,8 @@ import time
 
 import pytest
 
-from gymfg_il.viz import multiplayer as mp
-from gymfg_il.viz import peers
+from gymfg_il.flightgear import multiplayer as mp
+from gymfg_il.flightgear import peers
 
 
 def euler_from(angle_axis, lat_deg, lon_deg):
@@ -82,18 +81,6 @@ def test_ports_flightgear_cannot_store_are_refused():
 # -- receiving ------------------------------------------------------------------------------
 
 
-def free_mp_port():
-    """A free UDP port FlightGear could store (it keeps ports in 16 bits)."""
-    for port in range(22000 + os.getpid() % 9000, 32000):
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-            try:
-                s.bind(("127.0.0.1", port))
-            except OSError:
-                continue
-            return port
-    raise RuntimeError("no free UDP port below 32000")
-
-
 @pytest.mark.parametrize(
     "pose",
     [
@@ -143,9 +130,9 @@ def poll_until(link, done, deadline_s=30.0):
         time.sleep(0.005)
 
 
-def test_link_keeps_the_latest_per_callsign_and_drops_the_silent():
+def test_link_keeps_the_latest_per_callsign_and_drops_the_silent(free_udp_ports):
     now = [100.0]
-    port = free_mp_port()
+    (port,) = free_udp_ports(1)
     link = peers.MultiplayerLink(
         peers.MultiplayerConfig(listen_port=port, timeout_s=2.0), clock=lambda: now[0]
     )
@@ -176,12 +163,12 @@ def test_config_names_bad_ports_and_timeouts():
         peers.MultiplayerConfig(send_to=[("127.0.0.1", 99999)], timeout_s=0)
 
 
-def test_listen_prints_what_it_hears(tmp_path):
+def test_listen_prints_what_it_hears(tmp_path, free_udp_ports):
     """Listens until it has printed a line (however long a busy machine takes), then is
     stopped with ctrl-C, which ends it as --seconds would."""
-    port = free_mp_port()
+    (port,) = free_udp_ports(1)
     out = tmp_path / "heard.jsonl"
-    cmd = [sys.executable, "-m", "gymfg_il.viz.multiplayer", "listen", "--port", str(port)]
+    cmd = [sys.executable, "-m", "gymfg_il.flightgear.multiplayer", "listen", "--port", str(port)]
     proc = subprocess.Popen(
         [*cmd, "--seconds", "120", "--json", str(out)],
         stdout=subprocess.PIPE,

@@ -5,17 +5,27 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
+from gymfg_il.aircraft import Aircraft
 from gymfg_il.errors import ConfigError
+from gymfg_il.flightgear.multiplayer import TrafficSender
+from gymfg_il.flightgear.netfdm import FlightGearSender
 from gymfg_il.sim.properties import ORIENTATION, POSITION, indices
-from gymfg_il.viz.multiplayer import TrafficSender
-from gymfg_il.viz.netfdm import FlightGearSender
+from gymfg_il.sim.simulation import Simulation
 
-if TYPE_CHECKING:
-    from gymfg_il.envs.slots import Slot
+
+class Slot(Protocol):
+    """What the views read of an aircraft of the world (``envs.slots.Slot``)."""
+
+    @property
+    def callsign(self) -> str: ...
+
+    aircraft: Aircraft
+    sim: Simulation
+    state: np.ndarray
 
 
 class Displays:

@@ -1,0 +1,33 @@
+"""Old import paths that keep working for now: each is a tiny module whose names are looked
+up in the module's new home, with a ``DeprecationWarning`` that names it.
+
+The library itself never imports through an old path (``tests/test_layout.py`` checks it).
+"""
+
+from __future__ import annotations
+
+import importlib
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+
+def forward(old: str, new: str) -> Callable[[str], Any]:
+    """The module ``__getattr__`` of the old module ``old``: each name comes from ``new``,
+    with a DeprecationWarning pointing at the line that used the old path."""
+
+    def __getattr__(name: str) -> Any:
+        if name.startswith("__"):  # module machinery (``__all__``, ``__wrapped__``, ...)
+            raise AttributeError(f"module {old!r} has no attribute {name!r}")
+        module = importlib.import_module(new)
+        if not hasattr(module, name):
+            raise AttributeError(f"module {old!r} (now {new}) has no attribute {name!r}")
+        value = getattr(module, name)
+        warnings.warn(
+            f"{old} has moved to {new}: import {name} from {new}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return value
+
+    return __getattr__
