@@ -1,0 +1,44 @@
+"""The old import paths users write keep working, each with a DeprecationWarning that names
+the new home; the old ``python -m`` command runs the new one and says so."""
+
+import importlib
+import subprocess
+import sys
+
+import pytest
+
+MOVED = {  # old module -> (new module, a name users import from it)
+    "gymfg_il.controllers.agent": ("gymfg_il.agent", "ConstantAgent"),
+    "gymfg_il.viz.flightgear": ("gymfg_il.flightgear.launcher", "FlightGear"),
+    "gymfg_il.viz.netfdm": ("gymfg_il.flightgear.netfdm", "FlightGearSender"),
+    "gymfg_il.viz.peers": ("gymfg_il.flightgear.peers", "MultiplayerConfig"),
+    "gymfg_il.viz.multiplayer": ("gymfg_il.flightgear.multiplayer", "TrafficSender"),
+    "gymfg_il.manual.cockpit": ("gymfg_il.flightgear.cockpit", "CockpitReceiver"),
+}
+
+
+@pytest.mark.parametrize("old", sorted(MOVED))
+def test_an_old_path_gives_the_new_object_and_names_its_home(old):
+    new, name = MOVED[old]
+    with pytest.warns(DeprecationWarning, match=f"{old} has moved to {new}") as caught:
+        value = getattr(importlib.import_module(old), name)
+    assert value is getattr(importlib.import_module(new), name)
+    assert caught[0].filename == __file__  # it points at the line that used the old path
+
+
+def test_a_name_the_new_home_lacks_is_an_attribute_error_naming_both():
+    old = importlib.import_module("gymfg_il.viz.peers")
+    with pytest.raises(AttributeError, match=r"gymfg_il\.viz\.peers.*gymfg_il\.flightgear\.peers"):
+        old.NoSuchThing  # noqa: B018
+
+
+def test_the_old_multiplayer_command_runs_the_new_one_and_says_so():
+    proc = subprocess.run(
+        [sys.executable, "-m", "gymfg_il.viz.multiplayer", "listen", "--help"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "python -m gymfg_il.flightgear.multiplayer listen" in proc.stdout
+    assert "use python -m gymfg_il.flightgear.multiplayer" in proc.stderr
