@@ -46,7 +46,9 @@ class RepairConfig:
     """Write back the GymFG episode metadata (the gymfg/* columns: aircraft, task, seed,
     source, flight spec, ...) that LeRobot's own editing (lerobot-edit-dataset delete_episodes,
     split, merge, remove_feature) drops: each episode's is taken from the dataset it came
-    from, found by its frames.
+    from, found by its frames. The dataset card (README.md) is written again from them; a
+    dataset whose episodes kept their columns (a merge) gets its card written when it has
+    none or an outdated one.
 
     Attributes:
         dir: the edited dataset (meta/ inside), or a session folder (dataset/ inside).
@@ -224,7 +226,7 @@ def repair(folder: Path, sources: Sequence[Path]) -> int:
     """Restore the ``gymfg/*`` episode columns of the dataset at ``folder`` from ``sources``
     (``datasets.provenance.restore``)."""
     from gymfg_il.datasets import lerobot_api as lr
-    from gymfg_il.datasets.card import write_card
+    from gymfg_il.datasets.card import CARD, card_text, write_card
     from gymfg_il.datasets.provenance import metadata_columns, restore
 
     def dataset(path: Path) -> Path:
@@ -235,8 +237,18 @@ def repair(folder: Path, sources: Sequence[Path]) -> int:
 
     root = dataset(folder)
     meta = lr.open_metadata(root)
-    if metadata_columns(meta):
-        print(f"dataset {root}: its episodes have their gymfg/* columns; nothing to repair")
+    if metadata_columns(meta):  # a merge keeps them, but writes no card
+        card = root / CARD
+        old = card.read_text(encoding="utf-8") if card.is_file() else None
+        state = f"dataset {root}: its episodes have their gymfg/* columns"
+        if old == card_text(root, str(meta.repo_id), meta=meta):
+            print(f"{state} and its card is current; nothing to repair")
+            return 0
+        write_card(root, str(meta.repo_id), meta=meta)
+        print(
+            f"{state}; wrote its card {card} ({'none' if old is None else 'an outdated one'} "
+            "was there)"
+        )
         return 0
     if not sources:
         raise ConfigError(

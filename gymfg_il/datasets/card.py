@@ -6,8 +6,12 @@ way would say nothing of what it holds. The card's YAML front matter is LeRobot'
 ``task_categories``, the parquet ``configs``); its description says what a user of the data
 needs first: that the data are simulated (JSBSim and its version), the aircraft, tasks and
 sources, the DART noise, the weather, the rates, the episode and frame counts, every
-observation with its unit, the actions, and how to load the folder with stock LeRobot.
-Everything is read back from the dataset's own metadata (``info.json``, the task table and
+observation with its unit, the actions, how to load the folder with stock LeRobot, and its
+limitations (what the data is not: simulated flight of JSBSim's models, who or what flew, what
+was not recorded). The template's homepage, paper, license and citation say what is true of a
+local dataset: no homepage, GymFG-IL's license (the package's own), the paper whose design
+GymFG-IL builds on, and no BibTeX (no publication describes the dataset). Everything is read
+back from the dataset's own metadata (``info.json``, the task table and
 the per-episode ``gymfg/*`` columns), so the card always describes what the folder holds.
 """
 
@@ -15,15 +19,32 @@ from __future__ import annotations
 
 import json
 from collections import Counter
-from importlib.metadata import PackageNotFoundError, version
+from importlib.metadata import PackageNotFoundError, metadata, version
 from pathlib import Path
 from typing import Any
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.provenance import PREFIX
-from gymfg_il.sim.properties import ACTION_NAMES, BY_NAME
+from gymfg_il.sim.properties import ACTION_NAMES, BY_NAME, NAMES
 
 CARD = "README.md"
+PACKAGE = "gymfg-il"
+PAPER = (
+    'none describes this dataset; GymFG-IL builds on the design of "GymFG: A Framework with '
+    'a Gym Interface for FlightGear" (A. Wood, A. Sydney, P. Chin, B. Thapa, R. Ross)'
+)
+HOMEPAGE = "none: a local dataset folder, not published"
+# who or what each recorded source is (``gymfg/source``; a person taking over from an
+# assistant is ``ASSIST+human``)
+SOURCES = {
+    "autopilot": "GymFG-IL's PID autopilot (`gymfg_il.controllers.autopilot`); no person flew",
+    "human": "a person flying through GymFG-IL's manual controls (keyboard, mouse, joystick or "
+    "a FlightGear cockpit); who they are and how much they have flown is not recorded",
+    "synthetic": "a model of a person flying with the keyboard (`gymfg_il.manual.synthetic`), "
+    "not a person",
+    "dagger": "states a learned policy flew into, labelled by the task's autopilot: `action` is "
+    "the autopilot's label, not what was flown",
+}
 # units of task columns whose name carries no catalogue variable, by the name's ending
 _SUFFIX_UNITS = (
     ("_rad_s", "rad/s"),
@@ -59,8 +80,19 @@ def _installed(package: str) -> str:
         return "unknown"
 
 
+def _license() -> str | None:
+    """GymFG-IL's license as a Hub license id (``mit``), from the installed package's
+    metadata (pyproject's ``project.license``); None when the package is not installed."""
+    try:
+        meta = metadata(PACKAGE)
+    except PackageNotFoundError:
+        return None
+    found = meta.get("License-Expression") or meta.get("License")
+    return str(found).lower() if found else None
+
+
 def _counted(values: list[Any]) -> str:
-    counts = Counter(str(v) for v in values)
+    counts = Counter(str(v) for v in values if str(v))
     return (
         ", ".join(f"{k} ({n} episode{'s' * (n != 1)})" for k, n in sorted(counts.items()))
         or "unknown"
@@ -80,59 +112,142 @@ def episode_columns(root: Path) -> dict[str, list[Any]]:
     return out
 
 
+def _jsbsim(episodes: dict[str, list[Any]]) -> str:
+    recorded = sorted({str(v) for v in episodes.get("gymfg/jsbsim", []) if v})
+    return ", ".join(recorded) or (
+        f"version not recorded; {_installed('jsbsim')} where this card was written"
+    )
+
+
+def _facts(meta: Any, episodes: dict[str, list[Any]], specs: list[Any]) -> list[tuple[str, str]]:
+    """The card's table: what the dataset holds, one row per fact."""
+    features = meta.features
+    known = bool(episodes)
+    sim_hz = ", ".join(str(h) for h in sorted({s.sim_hz for s in specs})) or "unknown"
+    weather = {
+        f"turbulence {s.turbulence}, wind {s.wind_kt:g} kt"
+        + (f" from {s.wind_from_deg:g} deg" if s.wind_from_deg is not None else "")
+        for s in specs
+    }
+    starts = {"trimmed straight, level flight" if s.trimmed_starts else "untrimmed" for s in specs}
+    kinds = episodes.get("gymfg/target_kind", [])
+    aircraft = sorted(set(episodes.get("gymfg/aircraft", []))) or [str(meta.robot_type)]
+    cameras = [
+        f"`{k}` ({f['shape'][1]}x{f['shape'][0]} video)"
+        for k, f in features.items()
+        if f.get("dtype") == "video"
+    ]
+    ends = [v for v in episodes.get("gymfg/outcome", []) if v]
+    return [
+        (
+            "data",
+            f"simulated: the JSBSim flight dynamics model (JSBSim {_jsbsim(episodes)}); "
+            "no real aircraft flew",
+        ),
+        ("aircraft", ", ".join(aircraft)),
+        ("tasks", _counted(episodes.get("gymfg/task", [])) if known else "unknown"),
+        ("targets", _counted(kinds) if kinds else "not recorded"),
+        ("sources", _counted(episodes.get("gymfg/source", [])) if known else "unknown"),
+        (
+            "DART noise (action std)",
+            _counted(episodes.get("gymfg/noise", [])) if known else "unknown",
+        ),
+        ("weather", "; ".join(sorted(weather)) or "unknown"),
+        ("starts", ", ".join(sorted(starts)) or "unknown"),
+        ("episode ends", _counted(ends) if ends else "not recorded"),
+        ("rates", f"{meta.fps} fps (agent steps); JSBSim at {sim_hz} Hz"),
+        ("episodes", f"{meta.total_episodes} ({meta.total_frames} frames)"),
+        ("cameras", ", ".join(cameras) or "none"),
+        ("card written by", f"GymFG-IL {_installed(PACKAGE)}"),
+    ]
+
+
+def _source(name: str) -> str:
+    assist, _, person = name.rpartition("+")
+    if assist and person in SOURCES:
+        return (
+            f"{SOURCES[person]}; they took over from `{assist}` when they chose (the "
+            "`intervention` column marks the frames they flew)"
+        )
+    return SOURCES.get(name, "not described here (a source GymFG-IL does not know)")
+
+
+def limitations(
+    meta: Any, episodes: dict[str, list[Any]], specs: list[Any], names: list[str]
+) -> list[str]:
+    """The card's Limitations section (Markdown lines): what the data is not, read from the
+    dataset (``names``: the observation's)."""
+    aircraft = sorted(set(episodes.get("gymfg/aircraft", []))) or [str(meta.robot_type)]
+    sources = sorted({str(s) for s in episodes.get("gymfg/source", []) if s})
+    noisy = any(float(n) > 0 for n in episodes.get("gymfg/noise", []))
+    longest = max((s.episode_time_s for s in specs), default=None)
+    # the catalogue's commands are the flown actions, its clock the frame's timestamp
+    unobserved = [n for n in NAMES if n not in names and not n.endswith(("_cmd", "_time_s"))]
+    cameras = [k for k, f in meta.features.items() if f.get("dtype") == "video"]
+    who = [f"  - `{s}`: {_source(s)}." for s in sources] or ["  - not recorded."]
+    lines = [
+        "### Limitations",
+        "",
+        f"- **Simulated flight only.** Every frame was computed by JSBSim "
+        f"({_jsbsim(episodes)}); no real aircraft or sensor is behind it. Observations "
+        "are the simulator's exact values: no sensor noise, bias, latency or failure.",
+        f"- **Aircraft models.** {', '.join(f'`{a}`' for a in aircraft)}: JSBSim's own "
+        + (
+            "model of that name as the `jsbsim` package ships it: what it computes"
+            if len(aircraft) == 1
+            else "models of those names as the `jsbsim` package ships them: what they compute"
+        )
+        + ", not flight-test data of the aircraft. No other aircraft is in the data.",
+        "- **Who flew.**",
+        *who,
+    ]
+    if noisy:
+        lines.append(
+            "- **Actions are labels.** `action` is the demonstrator's command without the DART "
+            "noise that was added to what was flown; the flown commands are only in the "
+            "session's MCAP logs."
+        )
+    lines += [
+        "- **Weather.** JSBSim's standard atmosphere with the turbulence and steady wind of "
+        "the table; no precipitation, icing, cloud or change of temperature and pressure.",
+        "- **Flight regime.** Every episode starts in the air (the table's starts)"
+        + (f" and lasts at most {longest:g} s" if longest is not None else "")
+        + ": no takeoff, taxiing or landing; flying below the task's floor above the ground "
+        "counts as a crash and ends it.",
+        "- **Not recorded.** "
+        + (
+            f"The aircraft state the observation leaves out ({', '.join(unobserved)}) is not "
+            "in the dataset (the session's MCAP logs, where kept, hold it per step). "
+            if unobserved
+            else ""
+        )
+        + "Nothing of JSBSim's model beyond GymFG-IL's state catalogue (engine, fuel, "
+        "surface positions, loads) is recorded anywhere. "
+        + (
+            f"Camera features ({', '.join(f'`{c}`' for c in cameras)}) are drawn by "
+            "GymFG-IL's headless renderer from the simulated state, not filmed."
+            if cameras
+            else "No images."
+        ),
+    ]
+    return lines
+
+
 def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: Path) -> str:
     """The card's description (Markdown) of the dataset whose metadata is ``meta`` and whose
     episodes' ``gymfg/*`` columns are ``episodes``."""
     from gymfg_il.envs.flight import FlightSpec
 
-    features = meta.features
-    names = list(features["observation.state"]["names"] or [])
+    names = list(meta.features["observation.state"]["names"] or [])
     specs = [FlightSpec.from_json(s) for s in sorted(set(episodes.get("gymfg/spec", [])))]
-    recorded = sorted({str(v) for v in episodes.get("gymfg/jsbsim", []) if v})
-    jsbsim = ", ".join(recorded) or (
-        f"version not recorded; {_installed('jsbsim')} where this card was written"
-    )
-    sim_hz = sorted({s.sim_hz for s in specs})
-    weather = sorted(
-        {
-            f"turbulence {s.turbulence}, wind {s.wind_kt:g} kt"
-            + (f" from {s.wind_from_deg:g} deg" if s.wind_from_deg is not None else "")
-            for s in specs
-        }
-    )
     tasks = list(meta.tasks.index) if meta.tasks is not None else []
-    kinds = episodes.get("gymfg/target_kind", [])
-    aircraft = sorted(set(episodes.get("gymfg/aircraft", []))) or [str(meta.robot_type)]
-    rows = [
-        ("data", f"simulated: the JSBSim flight dynamics model (JSBSim {jsbsim}); "
-         "no real aircraft flew"),
-        ("aircraft", ", ".join(aircraft)),
-        ("tasks", _counted(episodes.get("gymfg/task", [])) if episodes else "unknown"),
-        ("targets", _counted(kinds) if kinds else "not recorded"),
-        ("sources", _counted(episodes.get("gymfg/source", [])) if episodes else "unknown"),
-        ("DART noise (action std)", _counted(episodes.get("gymfg/noise", []))
-         if episodes else "unknown"),
-        ("weather", "; ".join(weather) or "unknown"),
-        ("starts", ", ".join(sorted(
-            {"trimmed straight, level flight" if s.trimmed_starts else "untrimmed"
-             for s in specs}
-        )) or "unknown"),
-        ("rates", f"{meta.fps} fps (agent steps); JSBSim at "
-         f"{', '.join(str(h) for h in sim_hz) or 'unknown'} Hz"),
-        ("episodes", f"{meta.total_episodes} ({meta.total_frames} frames)"),
-        ("cameras", ", ".join(
-            f"`{k}` ({f['shape'][1]}x{f['shape'][0]} video)"
-            for k, f in features.items() if f.get("dtype") == "video"
-        ) or "none"),
-        ("card written by", f"GymFG-IL {_installed('gymfg-il')}"),
-    ]  # fmt: skip
     lines = [
         "Fixed-wing flight demonstrations recorded with GymFG-IL: one frame per agent step, "
         "`observation.state` the task's observation, `action` the demonstrator's controls.",
         "",
         "| | |",
         "| --- | --- |",
-        *(f"| {k} | {v} |" for k, v in rows),
+        *(f"| {k} | {v} |" for k, v in _facts(meta, episodes, specs)),
         "",
         "Per-frame task strings: " + ("; ".join(f"`{t}`" for t in tasks) or "none") + ".",
         "Per-episode metadata (seed, source, target, flight spec, log) is in the `gymfg/*` "
@@ -153,6 +268,8 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
             for i, n in enumerate(ACTION_NAMES)
         ),
         "",
+        *limitations(meta, episodes, specs, names),
+        "",
         "### Loading",
         "",
         "```python",
@@ -166,18 +283,36 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
     return "\n".join(lines)
 
 
-def write_card(
+def card_text(
     root: Path, repo_id: str = "gymfg/local", shown_root: Path | None = None, meta: Any = None
-) -> Path:
-    """Write (or rewrite) ``README.md`` of the dataset at ``root`` (``meta``: its finalised
-    metadata, else read; ``shown_root``: the folder the loading example names, when the
-    dataset is moved there); its path."""
+) -> str:
+    """The card of the dataset at ``root`` (``meta``: its finalised metadata, else read;
+    ``shown_root``: the folder the loading example names, when the dataset is moved there)."""
     root = Path(root)
     meta = meta if meta is not None else lr.open_metadata(root, repo_id)
     episodes = episode_columns(root)
     tags = ["gymfg", "jsbsim", "simulation", "fixed-wing", "imitation-learning"]
-    text = lr.dataset_card(meta, description(meta, episodes, repo_id, shown_root or root), tags)
-    path = root / CARD
+    return lr.dataset_card(
+        meta,
+        description(meta, episodes, repo_id, shown_root or root),
+        tags,
+        license=_license(),
+        homepage=HOMEPAGE,
+        paper=PAPER,
+        citation=(
+            "No BibTeX: no publication describes this dataset. To say how it was made, name "
+            f"GymFG-IL {_installed(PACKAGE)} and the JSBSim version above."
+        ),
+    )
+
+
+def write_card(
+    root: Path, repo_id: str = "gymfg/local", shown_root: Path | None = None, meta: Any = None
+) -> Path:
+    """Write (or rewrite) ``README.md`` of the dataset at ``root`` (``card_text``); its
+    path."""
+    text = card_text(root, repo_id, shown_root, meta)
+    path = Path(root) / CARD
     tmp = path.with_name(f".{CARD}.tmp")
     tmp.write_text(text, encoding="utf-8")
     tmp.replace(path)

@@ -201,15 +201,36 @@ def save_episode(
     )
 
 
-def dataset_card(meta: Any, description: str, tags: list[str]) -> str:
+def dataset_card(
+    meta: Any,
+    description: str,
+    tags: list[str],
+    *,
+    license: str | None,
+    homepage: str,
+    paper: str,
+    citation: str,
+) -> str:
     """The text of a dataset card made with LeRobot's own template (``card_template.md``,
-    through ``create_lerobot_dataset_card``): its YAML front matter, ``description`` and the
-    dataset's ``info.json``. No ``repo_id`` goes in: the template would link a Hub page the
-    local dataset does not have."""
+    through ``create_lerobot_dataset_card``): its YAML front matter (``license``: a Hub
+    license id, or None), ``description``, the template's homepage and paper lines, and the
+    dataset's ``info.json``. ``citation`` (Markdown) stands where the template asks for a
+    BibTeX entry, for a dataset no publication describes. No ``repo_id`` goes in: the
+    template would link a Hub page the local dataset does not have."""
     check_version()
     from lerobot.datasets.utils import create_lerobot_dataset_card
 
+    marker = "GYMFG_CITATION"
     card = create_lerobot_dataset_card(
-        tags=tags, dataset_info=meta.info, dataset_description=description
+        tags=tags,
+        dataset_info=meta.info,
+        dataset_description=description,
+        license=license,
+        url=homepage,
+        paper=paper,
+        citation_bibtex=marker,
     )
-    return str(card)
+    text = str(card)
+    block = f"**BibTeX:**\n\n```bibtex\n{marker}\n```"
+    assert text.count(block) == 1, "LeRobot's card template changed its citation block"
+    return text.replace(block, citation)

@@ -63,6 +63,58 @@ def test_a_collected_dataset_has_a_card_naming_what_it_holds(static):
     assert f'root="{root}"' in body  # the final folder, not the build's work copy
 
 
+def test_the_card_fills_the_templates_blanks_and_says_what_the_data_is_not(static):
+    import tomllib
+    from pathlib import Path
+
+    result, _ = static
+    text = (result.log.parent.parent / "dataset/README.md").read_text()
+    front, body = split_card(text)
+    assert "[More Information Needed]" not in text and "```bibtex" not in text
+    pyproject = Path(__file__).resolve().parents[2] / "pyproject.toml"
+    license = tomllib.loads(pyproject.read_text())["project"]["license"]
+    assert front["license"] == license.lower() == "mit"  # the package's, as a Hub id
+    assert "- **License:** mit" in body
+    assert "- **Homepage:** none" in body  # a local folder: no invented address
+    assert '"GymFG: A Framework with a Gym Interface for FlightGear"' in body
+    assert "No BibTeX: no publication describes this dataset" in body
+    limits = body[body.index("### Limitations") : body.index("### Loading")]
+    log = read_log(result.log)
+    assert f"computed by JSBSim ({log.session['versions']['jsbsim']})" in limits
+    assert "`c172p`: JSBSim's own model of that name" in limits
+    assert "`autopilot`: GymFG-IL's PID autopilot" in limits and "no person flew" in limits
+    assert "without the DART noise" in limits  # the default 0.05: labels, not what flew
+    assert "lasts at most 4 s" in limits and "no takeoff, taxiing or landing" in limits
+    assert "(lat_deg, lon_deg, altitude_agl_ft, heading_deg," in limits  # not observed
+    assert "aileron_cmd" not in limits  # the actions are in the dataset
+    assert "No images." in limits
+    assert "| episode ends | time limit (2 episodes) |" in body
+
+
+def test_the_cards_sources_say_who_flew():
+    from types import SimpleNamespace
+
+    from gymfg_il.datasets.card import limitations
+
+    meta = SimpleNamespace(robot_type="f15", features={"observation.images.front": {
+        "dtype": "video"}})  # fmt: skip
+    episodes = {
+        "gymfg/aircraft": ["f15", "A320"],
+        "gymfg/source": ["human", "controller+human", "synthetic", "dagger", "nobody"],
+        "gymfg/noise": [0.0] * 5,
+    }
+    text = "\n".join(limitations(meta, episodes, [], ["lat_deg"]))
+    assert "`A320`, `f15`: JSBSim's own models of those names as" in text
+    assert "`human`: a person flying" in text and "who they are" in text
+    assert "took over from `controller`" in text and "`intervention` column" in text
+    assert "`synthetic`: a model of a person" in text and "not a person" in text
+    assert "`dagger`: states a learned policy flew into" in text
+    assert "`nobody`: not described here" in text
+    assert "DART" not in text  # no noise: the labels are what was flown
+    assert "`observation.images.front`) are drawn by GymFG-IL's headless renderer" in text
+    assert "lon_deg" in text and "(lat_deg" not in text
+
+
 def test_units_of_task_columns():
     assert unit_of("roll_deg_error") == "deg" and unit_of("q_rad_s") == "rad/s"
     assert unit_of("gate_distance_ft") == "ft" and unit_of("behind_slot_rate_fps") == "ft/s"

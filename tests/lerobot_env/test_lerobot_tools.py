@@ -187,3 +187,31 @@ def test_collect_repair_restores_what_lerobot_edit_dataset_dropped(session, tmp_
     assert list(restored["gymfg/seed"]) == [1000, 1002]
     assert list(restored["gymfg/log_episode"]) == [0, 2]
     assert list(restored["gymfg/task"]) == ["roll", "roll"]
+
+
+def test_collect_repair_writes_the_card_a_merge_leaves_out(session, tmp_path, capsys):
+    other = tmp_path / "other"
+    argv = ["autopilot", "--task", "roll", "--episodes", "1", "--episode-time", "20"]
+    assert collect.main([*argv, "--seed", "2000", "--out", str(other), "--no-progress"]) == 0
+    merged = tmp_path / "merged"
+    roots = json.dumps([str(session / "dataset"), str(other / "dataset")])
+    _run(
+        [
+            str(BIN / "lerobot-edit-dataset"),
+            "--new_repo_id=gymfg/roll-merged",
+            f"--new_root={merged}",
+            "--operation.type=merge",
+            '--operation.repo_ids=["gymfg/roll-c172p", "gymfg/roll-other"]',
+            f"--operation.roots={roots}",
+        ],
+        tmp_path,
+    )
+    assert not (merged / "README.md").exists()  # what LeRobot's merge does
+    capsys.readouterr()
+    assert collect.main(["repair", str(merged)]) == 0
+    assert f"wrote its card {merged / 'README.md'} (none was there)" in capsys.readouterr().out
+    card = (merged / "README.md").read_text()
+    assert "| episodes | 4 (800 frames) |" in card
+    assert "| sources | autopilot (4 episodes) |" in card
+    assert collect.main(["repair", str(merged)]) == 0  # a current card is left alone
+    assert "its card is current; nothing to repair" in capsys.readouterr().out
