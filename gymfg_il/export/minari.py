@@ -26,6 +26,8 @@ episode_time_s, turbulence, wind_kt, wind_from_deg; ``recover_environment()`` ma
 ``gymnasium.make`` and its spaces are the dataset's. Only solo flights export (a team run's
 aircraft flew beside others, which no single gymnasium env reproduces). Nothing touches the
 network: Minari writes under ``root`` (its ``MINARI_DATASETS_PATH``) in its Arrow format.
+Its author, author email and code permalink are the user's or GymFG-IL's package metadata's
+(``export.credits``), and its requirements pin the GymFG-IL and JSBSim that flew it.
 """
 
 from __future__ import annotations
@@ -46,6 +48,7 @@ import numpy as np
 from gymfg_il.datasets.episode_logs import log_name_problem
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
+from gymfg_il.export.credits import Credits, credits
 from gymfg_il.names import BadNameError, name_problem
 
 DATA_FORMAT = "arrow"  # Minari's Arrow storage: pyarrow is here already (LeRobot); no h5py
@@ -69,11 +72,20 @@ class MinariConfig:
         root: the folder Minari keeps its datasets in; open them with
             MINARI_DATASETS_PATH=ROOT (default: $MINARI_DATASETS_PATH, else
             ~/.minari/datasets).
+        author: who made the dataset, repeatable (default: GymFG-IL's authors, from its
+            package metadata).
+        author_email: how to reach them, repeatable (default: the emails in GymFG-IL's
+            package metadata, if any; else none is set).
+        code_permalink: a link to the code that made the dataset (default: the source URL in
+            GymFG-IL's package metadata, if any; else none is set).
     """
 
     dataset: Path = field(metadata={"positional": True})
     name: str
     root: Path | None = None
+    author: list[str] = field(default_factory=list, metadata={"repeat": True})
+    author_email: list[str] = field(default_factory=list, metadata={"repeat": True})
+    code_permalink: str | None = None
 
     def __post_init__(self) -> None:
         problem = name_problem(self.name, "Minari dataset id")
@@ -95,6 +107,7 @@ class MinariSummary:
     episodes: int
     steps: int
     env_id: str
+    credits: Credits
 
 
 def env_spec(flight: FlightSpec) -> Any:
@@ -271,9 +284,12 @@ def _refly(
     )
 
 
-def export_dataset(dataset: Path, name: str, root: Path | None = None) -> MinariSummary:
+def export_dataset(
+    dataset: Path, name: str, root: Path | None = None, made_by: Credits | None = None
+) -> MinariSummary:
     """Write the LeRobot dataset at ``dataset`` as the Minari dataset ``name`` under
-    ``root`` (see the module docstring); what was written."""
+    ``root`` (see the module docstring; ``made_by``: its author, email and code permalink,
+    default ``credits()``: the package's); what was written."""
     import gymnasium as gym
     import minari
 
@@ -316,6 +332,7 @@ def export_dataset(dataset: Path, name: str, root: Path | None = None) -> Minari
     finally:
         env.close()
     sources = sorted(set(columns.get("gymfg/source", [])))
+    made_by = made_by if made_by is not None else credits()
     with minari_root(root) as where, warnings.catch_warnings():
         assert (where / name).resolve().is_relative_to(where), name  # the id's rule keeps it in
         for what in ("code_permalink", "author", "author_email", "eval_env"):
@@ -326,6 +343,10 @@ def export_dataset(dataset: Path, name: str, root: Path | None = None) -> Minari
                 buffer=buffers,
                 env=spec,
                 algorithm_name=", ".join(sources) or None,
+                author=set(made_by.author) or None,
+                author_email=set(made_by.author_email) or None,
+                code_permalink=made_by.code_permalink,
+                requirements=list(made_by.requirements) or None,
                 description=(
                     f"GymFG-IL demonstrations exported from the LeRobot dataset {folder.name}: "
                     f"{flight.aircraft} flying {flight.task_label} at {flight.agent_hz} Hz "
@@ -348,15 +369,19 @@ def export_dataset(dataset: Path, name: str, root: Path | None = None) -> Minari
             shutil.rmtree(where / name, ignore_errors=True)
             raise
     steps = int(sum(len(b.rewards) for b in buffers))
-    return MinariSummary(name, where, len(buffers), steps, str(spec.id))
+    return MinariSummary(name, where, len(buffers), steps, str(spec.id), made_by)
 
 
 def export_minari(cfg: MinariConfig) -> int:
     """``collect export minari``: write the dataset and say how to open it."""
-    s = export_dataset(cfg.dataset, cfg.name, cfg.root)
+    made_by = credits(cfg.author, cfg.author_email, cfg.code_permalink)
+    s = export_dataset(cfg.dataset, cfg.name, cfg.root, made_by)
+    unset = made_by.unset()
     print(
         f"wrote Minari dataset {s.name} under {s.root}: {s.episodes} episodes, {s.steps} "
-        f"steps, env {s.env_id}\nopen it: MINARI_DATASETS_PATH={s.root} python -c "
+        f"steps, env {s.env_id}; author {', '.join(made_by.author) or 'not set'}"
+        + (f" (not set: {', '.join(unset)})" if unset else "")
+        + f"\nopen it: MINARI_DATASETS_PATH={s.root} python -c "
         f"\"import minari; print(minari.load_dataset('{s.name}'))\""
     )
     return 0

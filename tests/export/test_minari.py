@@ -96,6 +96,35 @@ def test_the_cli_exports_a_clean_dataset_folder_without_its_logs(tmp_path, capsy
     assert "already exists" in capsys.readouterr().err
 
 
+def test_the_export_names_who_made_it_and_with_what_code(tmp_path, capsys, monkeypatch):
+    from importlib.metadata import metadata, version
+
+    session = _session(tmp_path / "clean", 0.0)
+    root = tmp_path / "minari"
+    argv = ["export", "minari", str(session), "--root", str(root)]
+    assert collect.main([*argv, "--name", "gymfg/plain-v0"]) == 0
+    package = metadata("gymfg-il")["Author"]
+    assert package == "GymFG-IL contributors"  # pyproject's authors
+    out = capsys.readouterr().out
+    assert f"author {package} (not set: --author-email, --code-permalink)" in out
+    given = [
+        "--author", "Ada", "--author", "Grace", "--author-email", "ada@example.org",
+        "--code-permalink", "https://example.org/gymfg-il/tree/abc123",
+    ]  # fmt: skip
+    assert collect.main([*argv, "--name", "gymfg/credited-v0", *given]) == 0
+    assert "not set" not in capsys.readouterr().out
+    monkeypatch.setenv("MINARI_DATASETS_PATH", str(root))
+    plain = minari.load_dataset("gymfg/plain-v0").storage.metadata
+    assert plain["author"] == {package} and "author_email" not in plain  # none invented
+    assert "code_permalink" not in plain
+    pins = [f"gymfg-il=={version('gymfg-il')}", f"jsbsim=={version('jsbsim')}"]
+    assert plain["requirements"] == pins
+    credited = minari.load_dataset("gymfg/credited-v0").storage.metadata
+    assert credited["author"] == {"Ada", "Grace"}
+    assert credited["author_email"] == {"ada@example.org"}
+    assert credited["code_permalink"] == "https://example.org/gymfg-il/tree/abc123"
+
+
 def test_what_cannot_be_exported_says_why(noisy, tmp_path):
     alone = tmp_path / "alone"
     shutil.copytree(noisy / "dataset", alone)
