@@ -25,8 +25,8 @@ from gymfg_il.controllers.gains import Gains, gains_for
 from gymfg_il.controllers.pid import PID
 from gymfg_il.errors import ConfigError
 from gymfg_il.tasks.orientation import bank_for_turn_rate
+from gymfg_il.units import RAD_TO_DEG, wrap_180
 
-_R2D = 57.29577951308232
 # a heading target turning faster than this jumped (a new target): no turn feed-forward
 MAX_FEED_FORWARD_TURN_DEG_S = 10.0
 
@@ -220,18 +220,20 @@ class Autopilot:
             pitch_target = self.climb_pid(climb_target, obs[i["vertical_speed_fps"]], dt)
         pitch_target = max(-g.max_pitch_deg, min(g.max_pitch_deg, pitch_target))
         self._load_integral("pitch", self.pitch_pid, obs, pitch_target - obs[i["pitch_deg"]])
-        nose_up = self.pitch_pid(pitch_target, obs[i["pitch_deg"]], dt, obs[i["q_rad_s"]] * _R2D)
+        nose_up = self.pitch_pid(
+            pitch_target, obs[i["pitch_deg"]], dt, obs[i["q_rad_s"]] * RAD_TO_DEG
+        )
         # lateral: heading -> roll -> aileron
         if t.lateral in ("heading", "track"):
             heading_target = self._value(obs, t.lateral_source, "heading_deg", "lateral")
             if t.lateral == "track":  # the line's course, turned towards the line
                 off = t.track_gain * obs[i[str(t.track_source)]]
                 heading_target -= max(-t.track_limit_deg, min(t.track_limit_deg, off))
-            err = (heading_target - obs[i["heading_deg"]] + 180.0) % 360.0 - 180.0
+            err = wrap_180(heading_target - obs[i["heading_deg"]])
             # feed-forward: the bank of a coordinated turn at the target's own turn rate (a
             # jump, such as the next gate's bearing, is a new target, not a turn)
             last, self._last_heading_target = self._last_heading_target, heading_target
-            turn = 0.0 if last is None else ((heading_target - last + 180.0) % 360.0 - 180.0) / dt
+            turn = 0.0 if last is None else wrap_180(heading_target - last) / dt
             if abs(turn) > MAX_FEED_FORWARD_TURN_DEG_S:
                 turn = 0.0
             roll_target = g.heading_to_roll * err + bank_for_turn_rate(turn, obs[i["airspeed_kts"]])
@@ -243,7 +245,7 @@ class Autopilot:
             else roll_target
         )
         self._load_integral("roll", self.roll_pid, obs, roll_target - obs[i["roll_deg"]])
-        aileron = self.roll_pid(roll_target, obs[i["roll_deg"]], dt, obs[i["p_rad_s"]] * _R2D)
+        aileron = self.roll_pid(roll_target, obs[i["roll_deg"]], dt, obs[i["p_rad_s"]] * RAD_TO_DEG)
         # speed: airspeed -> throttle; rudder: sideslip -> 0
         if t.station_source is not None:
             kp, kd = t.station_gains

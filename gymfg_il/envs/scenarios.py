@@ -22,6 +22,7 @@ from gymfg_il.aircraft import Aircraft
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.tasks.geometry import offset_position
+from gymfg_il.units import wrap_360
 
 # (rng, [(team name, aircraft), ...]) -> {callsign: ic}
 Scenario = Callable[
@@ -73,7 +74,7 @@ class Formation:
                 lat,
                 lon,
                 base.altitude_ft,
-                heading % 360.0,
+                wrap_360(heading),
                 base.airspeed_kts,
                 trimmed=base.trimmed,
             )

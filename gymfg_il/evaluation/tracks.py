@@ -13,7 +13,8 @@ import numpy as np
 from gymfg_il.evaluation.plots import save_figure
 from gymfg_il.evaluation.trace import Trace
 from gymfg_il.sim.properties import INDEX
-from gymfg_il.tasks.maneuvers import FT_PER_DEG, local_ft, wrap
+from gymfg_il.tasks.maneuvers import local_ft
+from gymfg_il.units import FT_PER_DEG, FT_PER_NM, wrap_180
 
 COLOURS = ("black", "tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown")
 
@@ -35,7 +36,7 @@ def _draw_plan(top: Any, side: Any, plan: Mapping[str, Any], origin: tuple[float
     if "lead" in plan:  # the lead's track (lat, lon, altitude, roll, pitch, heading per step)
         lead = np.asarray(plan["lead"])
         north = (lead[:, 0] - origin[0]) * FT_PER_DEG
-        east = wrap(lead[:, 1] - origin[1]) * FT_PER_DEG * math.cos(math.radians(origin[0]))
+        east = wrap_180(lead[:, 1] - origin[1]) * FT_PER_DEG * math.cos(math.radians(origin[0]))
         top.plot(east, north, color="tab:red", ls="--", lw=1, label="lead")
 
     if "gates" in plan:
@@ -45,13 +46,13 @@ def _draw_plan(top: Any, side: Any, plan: Mapping[str, Any], origin: tuple[float
             top.annotate(str(k + 1), (east, north), color="tab:red", fontsize=8)
     if "threshold" in plan:
         c = math.radians(plan["course_deg"])
-        back = np.array([0.0, 6.0 * 6076.12])
+        back = np.array([0.0, 6.0 * FT_PER_NM])
         top.plot(-back * math.sin(c), -back * math.cos(c), color="tab:red", ls="--", lw=0.8)
         top.plot([0, 6000 * math.sin(c)], [0, 6000 * math.cos(c)], color="tab:gray", lw=3)
         tan = math.tan(math.radians(plan["glide_deg"]))
-        x = np.linspace(0, 5 * 6076.12, 50)
+        x = np.linspace(0, 5 * FT_PER_NM, 50)
         path = plan["threshold_ft"] + np.maximum(plan["decision_height_ft"], x * tan)
-        side.plot(x / 6076.12, path, color="tab:red", ls="--", lw=1, label="glide path")
+        side.plot(x / FT_PER_NM, path, color="tab:red", ls="--", lw=1, label="glide path")
         side.invert_xaxis()
 
 
@@ -83,7 +84,7 @@ def ground_tracks(
             if approach:
                 c = math.radians(plan["course_deg"])
                 along = -(north * math.cos(c) + east * math.sin(c))
-                side.plot(along / 6076.12, alt, color=colour, lw=1)
+                side.plot(along / FT_PER_NM, alt, color=colour, lw=1)
             else:
                 side.plot(np.arange(len(alt)) * tr.dt, alt, color=colour, lw=1)
         if not approach:  # the altitude each step aimed for (the next gate's, ...)

@@ -38,9 +38,8 @@ import numpy as np
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import Log, LoggedEpisode, read_log
 from gymfg_il.sim.properties import INDEX
+from gymfg_il.units import FT_TO_M, KT_TO_MS, wrap_360
 
-FT_TO_M = 0.3048
-KT_TO_MS = 1852.0 / 3600.0
 EPISODE_GAP_S = 1.0
 
 # JSBSim model -> the name Tacview's object database knows (others keep their JSBSim name).
@@ -125,7 +124,7 @@ def _angle(value: float) -> str:
 
 def _pose(row: np.ndarray) -> str:
     lon, lat, alt_ft, roll, pitch = (float(row[i]) for i in _POSE)
-    yaw = float(row[_YAW]) % 360.0
+    yaw = wrap_360(float(row[_YAW]))
     angles = "|".join(_angle(a) for a in (roll, pitch, yaw))
     return f"T={lon:.7f}|{lat:.7f}|{alt_ft * FT_TO_M:.2f}|{angles}"
 

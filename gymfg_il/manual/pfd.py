@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from gymfg_il.units import wrap_180
+
 SKY, GROUND = (40, 110, 190), (125, 85, 45)
 WHITE, YELLOW, MAGENTA = (235, 235, 235), (250, 210, 40), (235, 80, 235)
 TAPE, EDGE = (35, 40, 50), (120, 130, 150)
@@ -167,7 +169,7 @@ class PrimaryFlightDisplay:
             pg.draw.line(surface, EDGE, (x, rect.top), (x, rect.top + 8), 1)
             surface.blit(self._label(f"{tick % 360:03d}"), (x - 12, rect.top + 10))
         if target is not None:
-            off = (target - heading + 180.0) % 360.0 - 180.0
+            off = wrap_180(target - heading)
             x = max(rect.left + 4, min(rect.right - 4, rect.centerx + off * px_per_deg))
             pg.draw.rect(surface, MAGENTA, (x - 4, rect.top, 8, 6))
         surface.set_clip(clip)

@@ -16,6 +16,7 @@ from torch import nn
 
 from gymfg_il.policies.configuration_vision import ROLL_INVARIANT, VisionConfig
 from gymfg_il.policies.normalize import NormalizedPolicy
+from gymfg_il.units import DEG_TO_RAD, wrap_180
 
 
 class VisionPolicy(NormalizedPolicy):
@@ -155,7 +156,7 @@ class VisionPolicy(NormalizedPolicy):
             return images, truth, weight
         n = int(chosen.sum())
         angle = (torch.rand(n, device=images.device) * 2 - 1) * cfg.roll_augment_deg
-        a = angle * (math.pi / 180.0)
+        a = angle * DEG_TO_RAD
         cos, sin, zero = torch.cos(a), torch.sin(a), torch.zeros_like(a)
         theta = torch.stack(
             [torch.stack([cos, -sin, zero], 1), torch.stack([sin, cos, zero], 1)], 1
@@ -168,7 +169,7 @@ class VisionPolicy(NormalizedPolicy):
         images[chosen] = x
         truth, weight = truth.clone(), weight.clone()
         roll = truth[chosen, self.roll_at] + angle
-        truth[chosen, self.roll_at] = torch.remainder(roll + 180.0, 360.0) - 180.0
+        truth[chosen, self.roll_at] = wrap_180(roll)
         weight[chosen] = self.kept_when_rolled.to(weight.dtype)
         return images, truth, weight
 

@@ -38,10 +38,10 @@ import numpy as np
 
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.scenery import Landmark
+from gymfg_il.units import FT_TO_M
 
 SCHEMAS = Path(__file__).with_name("foxglove_schemas")
 PARENT_FRAME = "enu"
-FT_TO_M = 0.3048
 _A = 6378137.0  # WGS84 semi-major axis, m
 _E2 = 6.69437999014e-3  # WGS84 first eccentricity squared
 

@@ -12,7 +12,6 @@ workers). Both end in the same messages.
 from __future__ import annotations
 
 import json
-import math
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -29,10 +28,9 @@ from gymfg_il.recording.session import CHANNELS_METADATA, SESSION_COPY, SESSION_
 from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
 from gymfg_il.sim.properties import ACTION_NAMES, INDEX, NAMES
 from gymfg_il.tasks.scenery import task_landmarks
+from gymfg_il.units import DEG_TO_RAD, FT_TO_M
 
 EPISODE_TOPIC = "/gymfg/episode"
-_FT_TO_M = fg.FT_TO_M
-_DEG_TO_RAD = math.pi / 180.0
 _INITIAL = ("lat_deg", "lon_deg", "altitude_ft")
 _HEADING = INDEX["heading_deg"]
 _NO_COVARIANCE = [0.0] * 9
@@ -216,7 +214,7 @@ class TrajectoryWriter:
         if not starts:
             return
         lat, lon, alt_ft = starts[0].state[:3].tolist()
-        self._frame = fg.LocalFrame(lat, lon, alt_ft * _FT_TO_M)
+        self._frame = fg.LocalFrame(lat, lon, alt_ft * FT_TO_M)
         for s in starts:
             if s.callsign not in self._scenes:
                 continue
@@ -335,10 +333,10 @@ class TrajectoryWriter:
                 "frame_id": callsign,
                 "latitude": values[0],
                 "longitude": values[1],
-                "altitude": values[2] * _FT_TO_M,
+                "altitude": values[2] * FT_TO_M,
                 "position_covariance": _NO_COVARIANCE,
                 "position_covariance_type": 0,
-                "heading": values[_HEADING] * _DEG_TO_RAD,
+                "heading": values[_HEADING] * DEG_TO_RAD,
                 "velocity": velocity,
             },
         )

@@ -13,12 +13,12 @@ import math
 from dataclasses import dataclass
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.units import KT_TO_FPS
 
 # WGS84 in feet, as JSBSim's default planet.
 _A_FT = 20925646.32546
 _B_FT = 20855486.5951
 _E2 = 1.0 - (_B_FT * _B_FT) / (_A_FT * _A_FT)
-_KTS_TO_FPS = 1.6878098571011957
 
 
 def ecef_ft(latitude_deg: float, longitude_deg: float, altitude_ft: float) -> tuple[float, ...]:
@@ -100,7 +100,7 @@ class InitialConditions:
         east, ft/s) the ground velocity is the air velocity plus the wind, so the airspeed
         is the one asked for."""
         x, y, z = ecef_ft(self.latitude_deg, self.longitude_deg, self.altitude_ft)
-        speed = self.airspeed_kts * _KTS_TO_FPS
+        speed = self.airspeed_kts * KT_TO_FPS
         psi = math.radians(self.heading_deg)
         north, east = speed * math.cos(psi), speed * math.sin(psi)
         if wind_fps != (0.0, 0.0):

@@ -21,8 +21,8 @@ from typing import Any, Literal
 import numpy as np
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.units import KT_TO_FPS, wrap_360
 
-KT_TO_FPS = 1.6878098571011957
 # turbulence -> (JSBSim turb-type, severity index, wind speed at 20 ft in ft/s)
 TURBULENCE: dict[str, tuple[int, int, float]] = {
     "none": (0, 0, 0.0),
@@ -96,4 +96,4 @@ class Air:
         fdm["atmosphere/randomseed"] = self.seed
         north, east = self.wind
         fdm["ic/vw-mag-fps"] = math.hypot(north, east)
-        fdm["ic/vw-dir-deg"] = math.degrees(math.atan2(east, north)) % 360.0  # blows toward
+        fdm["ic/vw-dir-deg"] = wrap_360(math.degrees(math.atan2(east, north)))  # blows toward

@@ -15,14 +15,13 @@ import numpy as np
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.geometry import offset_position
-from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft, wrap
+from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft
 from gymfg_il.tasks.rewards import closeness
 from gymfg_il.tasks.scenery import Landmark
+from gymfg_il.units import FT_PER_NM, KT_TO_FPS, wrap_180, wrap_360
 
 _ALT, _HDG, _VC = INDEX["altitude_ft"], INDEX["heading_deg"], INDEX["airspeed_kts"]
 _LAT, _LON = INDEX["lat_deg"], INDEX["lon_deg"]
-FT_PER_NM = 6076.12
-KTS_TO_FPS = 1.6878098571011957
 
 
 class WaypointsTask(ManeuverTask):
@@ -62,7 +61,7 @@ class WaypointsTask(ManeuverTask):
     altitude_tolerance_ft = 150.0
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
-        speed = self._profile().cruise_kts * KTS_TO_FPS
+        speed = self._profile().cruise_kts * KT_TO_FPS
         course = float(state[_HDG]) + float(rng.uniform(-45.0, 45.0))
         north = east = 0.0
         alt = float(state[_ALT])
@@ -100,15 +99,15 @@ class WaypointsTask(ManeuverTask):
         if k == len(gates):  # all passed: hold the last leg's course and the last altitude
             (n0, e0, _), (n1, e1, a1) = gates[-2], gates[-1]
             course = math.degrees(math.atan2(e1 - e0, n1 - n0))
-            return [0.0, wrap(course - heading), a1 - alt, 0.0, 0.0]
+            return [0.0, wrap_180(course - heading), a1 - alt, 0.0, 0.0]
         gn, ge, ga = gates[k]
         bearing = math.degrees(math.atan2(ge - east, gn - north))
         turn = 0.0
         if k + 1 < len(gates):
             nn, ne, _ = gates[k + 1]
-            turn = wrap(math.degrees(math.atan2(ne - ge, nn - gn)) - bearing)
+            turn = wrap_180(math.degrees(math.atan2(ne - ge, nn - gn)) - bearing)
         distance = math.hypot(gn - north, ge - east)
-        return [distance, wrap(bearing - heading), ga - alt, turn, float(len(gates) - k)]
+        return [distance, wrap_180(bearing - heading), ga - alt, turn, float(len(gates) - k)]
 
     def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
         return (
@@ -205,7 +204,7 @@ class ApproachTask(ManeuverTask):
         return dataclasses.replace(ic, airspeed_kts=speed)
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
-        course = (float(state[_HDG]) + float(rng.uniform(-30.0, 30.0))) % 360.0
+        course = wrap_360(float(state[_HDG]) + float(rng.uniform(-30.0, 30.0)))
         distance = float(rng.uniform(3.5, 4.0)) * FT_PER_NM
         offset = float(rng.uniform(-1500.0, 1500.0))
         c, s = math.cos(math.radians(course)), math.sin(math.radians(course))
@@ -253,7 +252,7 @@ class ApproachTask(ManeuverTask):
         return [
             float(g["distance"]),
             float(g["offset"]),
-            wrap(plan["course_deg"] - float(state[_HDG])),
+            wrap_180(plan["course_deg"] - float(state[_HDG])),
             float(g["glidepath"]),
             speed_error,
             self._integral,

@@ -19,9 +19,10 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX, indices
 from gymfg_il.tasks.geometry import offset_position
-from gymfg_il.tasks.maneuvers import FT_PER_DEG, ManeuverTask, Verdict, wrap
+from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict
 from gymfg_il.tasks.rewards import closeness
 from gymfg_il.tasks.scenery import Landmark
+from gymfg_il.units import FT_PER_DEG, wrap_180, wrap_360
 
 LEAD_VIEW = ("lat_deg", "lon_deg", "altitude_ft", "roll_deg", "pitch_deg", "heading_deg")
 _LEAD_IDX = indices(LEAD_VIEW)
@@ -46,7 +47,7 @@ def _lead_schedule(
             next_change = t + float(rng.uniform(20.0, 25.0))
         heading += max(-3.0 * dt, min(3.0 * dt, hdg_goal - heading))
         altitude += max(-5.0 * dt, min(5.0 * dt, alt_goal - altitude))
-        alt_t[i], hdg_t[i] = altitude, heading % 360.0
+        alt_t[i], hdg_t[i] = altitude, wrap_360(heading)
     return alt_t, hdg_t
 
 
@@ -136,7 +137,7 @@ class FormationTask(ManeuverTask):
         lead = track[np.minimum(steps, len(track) - 1)]
         cos_lat = math.cos(math.radians(float(lead[0, 0])))
         north = (states[:, _LAT] - lead[:, 0]) * FT_PER_DEG
-        east = wrap(states[:, _LON] - lead[:, 1]) * FT_PER_DEG * cos_lat
+        east = wrap_180(states[:, _LON] - lead[:, 1]) * FT_PER_DEG * cos_lat
         h = np.radians(lead[:, 5])
         fwd = north * np.cos(h) + east * np.sin(h)  # ahead of the lead (ft)
         right = -north * np.sin(h) + east * np.cos(h)
@@ -161,7 +162,7 @@ class FormationTask(ManeuverTask):
             rate,
             float(g["right"][0]),
             float(g["below"][0]),
-            wrap(float(lead[5]) - float(state[_HDG])),
+            wrap_180(float(lead[5]) - float(state[_HDG])),
             float(lead[3]),
             float(lead[4]),
         ]

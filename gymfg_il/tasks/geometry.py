@@ -10,8 +10,7 @@ from __future__ import annotations
 import math
 
 from gymfg_il.sim.initial import ecef_ft
-
-_EARTH_RADIUS_FT = 20902230.97  # mean radius, for local north/east offsets
+from gymfg_il.units import EARTH_RADIUS_FT, wrap_180, wrap_360
 
 
 def distance_ft(a: object, b: object) -> float:
@@ -25,16 +24,16 @@ def horizontal_offset_ft(a: object, b: object) -> tuple[float, float]:
     """(north, east) of ``b`` seen from ``a`` in ft, on a local flat-earth approximation."""
     lat_a, lon_a = a.lat_deg, a.lon_deg  # type: ignore[attr-defined]
     lat_b, lon_b = b.lat_deg, b.lon_deg  # type: ignore[attr-defined]
-    north = math.radians(lat_b - lat_a) * _EARTH_RADIUS_FT
-    dlon = (lon_b - lon_a + 180.0) % 360.0 - 180.0
-    east = math.radians(dlon) * _EARTH_RADIUS_FT * math.cos(math.radians((lat_a + lat_b) / 2))
+    north = math.radians(lat_b - lat_a) * EARTH_RADIUS_FT
+    dlon = wrap_180(lon_b - lon_a)
+    east = math.radians(dlon) * EARTH_RADIUS_FT * math.cos(math.radians((lat_a + lat_b) / 2))
     return north, east
 
 
 def bearing_deg(a: object, b: object) -> float:
     """True bearing from ``a`` to ``b`` in [0, 360)."""
     north, east = horizontal_offset_ft(a, b)
-    return math.degrees(math.atan2(east, north)) % 360.0
+    return wrap_360(math.degrees(math.atan2(east, north)))
 
 
 def altitude_difference_ft(a: object, b: object) -> float:
@@ -46,6 +45,6 @@ def offset_position(
     lat_deg: float, lon_deg: float, north_ft: float, east_ft: float
 ) -> tuple[float, float]:
     """The (lat, lon) ``north_ft`` north and ``east_ft`` east of a point."""
-    lat = lat_deg + math.degrees(north_ft / _EARTH_RADIUS_FT)
-    lon = lon_deg + math.degrees(east_ft / (_EARTH_RADIUS_FT * math.cos(math.radians(lat_deg))))
-    return lat, (lon + 180.0) % 360.0 - 180.0
+    lat = lat_deg + math.degrees(north_ft / EARTH_RADIUS_FT)
+    lon = lon_deg + math.degrees(east_ft / (EARTH_RADIUS_FT * math.cos(math.radians(lat_deg))))
+    return lat, wrap_180(lon)

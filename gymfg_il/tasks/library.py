@@ -43,6 +43,7 @@ from gymfg_il.tasks.targets import (
     TargetFamily,
     TargetTask,
 )
+from gymfg_il.units import wrap_180
 
 
 class DummyTask(Task):
@@ -197,7 +198,7 @@ class LevelFlightTask(Task):
 
     def errors(self, state: np.ndarray) -> tuple[float, float]:
         """(altitude error ft, heading error deg) of ``state``."""
-        heading_err = (self.start_heading - state[_HDG] + 180.0) % 360.0 - 180.0
+        heading_err = wrap_180(self.start_heading - state[_HDG])
         return self.start_altitude - float(state[_ALT]), float(heading_err)
 
     def tracked(self) -> dict[str, Any]:

@@ -26,11 +26,11 @@ import numpy as np
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
 from gymfg_il.tasks.rewards import RewardContext, action_change, closeness
+from gymfg_il.units import FT_PER_DEG, wrap_180, wrap_360
 
 HOLD_S = 10.0  # the last seconds over which a maneuver's end state must hold
 SMOOTHNESS_WEIGHT = 0.05
 _ALT, _HDG = INDEX["altitude_ft"], INDEX["heading_deg"]
-FT_PER_DEG = math.pi / 180.0 * 20902230.97  # feet per degree of latitude (mean Earth radius)
 
 
 @dataclass(frozen=True)
@@ -41,18 +41,13 @@ class Verdict:
     detail: str
 
 
-def wrap(angle: Any) -> Any:
-    """Angles (scalars or arrays) folded into [-180, 180)."""
-    return (angle + 180.0) % 360.0 - 180.0
-
-
 def local_ft(states: np.ndarray, origin: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
     """(north, east) in ft of catalogue-ordered ``states`` (rows) from ``origin`` (lat, lon),
     on a flat earth around the origin (errors below 0.1 % over the few miles a task spans)."""
     lat = states[..., INDEX["lat_deg"]]
     lon = states[..., INDEX["lon_deg"]]
     north = (lat - origin[0]) * FT_PER_DEG
-    east = wrap(lon - origin[1]) * FT_PER_DEG * math.cos(math.radians(origin[0]))
+    east = wrap_180(lon - origin[1]) * FT_PER_DEG * math.cos(math.radians(origin[0]))
     return north, east
 
 
@@ -175,7 +170,7 @@ class TurnTask(ManeuverTask):
         heading = float(state[_HDG])
         if step == 0:
             self._turned, self._last, self._integral = 0.0, heading, 0.0
-        self._turned += wrap(heading - self._last)
+        self._turned += wrap_180(heading - self._last)
         self._last = heading
         alt_err = self.plan["altitude_ft"] - float(state[_ALT])
         if step:
@@ -236,7 +231,7 @@ class ClimbTurnTask(ManeuverTask):
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
         return {
             "altitude_ft": float(state[_ALT]) + _signed(rng, 300.0, 1000.0),
-            "heading_deg": (float(state[_HDG]) + _signed(rng, 30.0, 90.0)) % 360.0,
+            "heading_deg": wrap_360(float(state[_HDG]) + _signed(rng, 30.0, 90.0)),
         }
 
     def extras(self, state: np.ndarray, step: int) -> list[float]:
@@ -247,7 +242,7 @@ class ClimbTurnTask(ManeuverTask):
             limit = self.integral_limit
             self._integral = max(-limit, min(limit, self._integral + alt_err * self.dt))
         hdg = self.plan["heading_deg"]
-        return [self.plan["altitude_ft"], alt_err, self._integral, hdg, wrap(hdg - state[_HDG])]
+        return [self.plan["altitude_ft"], alt_err, self._integral, hdg, wrap_180(hdg - state[_HDG])]
 
     def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
         return 0.5 * closeness(extras[1], 200.0) + 0.5 * closeness(extras[4], 10.0)
@@ -256,7 +251,7 @@ class ClimbTurnTask(ManeuverTask):
     def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
         tail = states[-hold_steps(dt) :]
         alt = np.abs(plan["altitude_ft"] - tail[:, _ALT]).max()
-        hdg = np.abs(wrap(plan["heading_deg"] - tail[:, _HDG])).max()
+        hdg = np.abs(wrap_180(plan["heading_deg"] - tail[:, _HDG])).max()
         ok = len(states) > hold_steps(dt) and alt <= cls.altitude_tolerance
         ok = ok and hdg <= cls.heading_tolerance
         return Verdict(

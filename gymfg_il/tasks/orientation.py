@@ -4,15 +4,15 @@ from __future__ import annotations
 
 import math
 
+from gymfg_il.units import KT_TO_FPS, wrap_180, wrap_360
 
-def wrap_180(angle_deg: float) -> float:
-    """``angle_deg`` folded into [-180, 180)."""
-    return (angle_deg + 180.0) % 360.0 - 180.0
-
-
-def wrap_360(angle_deg: float) -> float:
-    """``angle_deg`` folded into [0, 360)."""
-    return angle_deg % 360.0
+__all__ = [
+    "angle_difference_deg",
+    "bank_for_turn_rate",
+    "relative_heading_deg",
+    "wrap_180",
+    "wrap_360",
+]
 
 
 def angle_difference_deg(to_deg: float, from_deg: float) -> float:
@@ -27,5 +27,5 @@ def relative_heading_deg(own: object, other: object) -> float:
 
 def bank_for_turn_rate(turn_rate_deg_s: float, true_airspeed_kts: float) -> float:
     """Bank angle (deg) of a coordinated turn at ``turn_rate_deg_s``."""
-    v_fps = true_airspeed_kts * 1.6878098571011957
+    v_fps = true_airspeed_kts * KT_TO_FPS
     return math.degrees(math.atan(math.radians(turn_rate_deg_s) * v_fps / 32.174))

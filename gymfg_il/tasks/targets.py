@@ -21,6 +21,7 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import BY_NAME, INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
 from gymfg_il.tasks.rewards import RewardContext, action_change
+from gymfg_il.units import wrap_180, wrap_360
 
 
 @dataclass(frozen=True, slots=True)
@@ -145,7 +146,7 @@ class TargetTask(Task):
     def _absolute(self, value: float) -> float:
         if self.family.relative:
             value = self.start_value + value
-        return value % 360.0 if self.family.angular else value
+        return wrap_360(value) if self.family.angular else value
 
     def reset(self, state: np.ndarray, rng: np.random.Generator) -> None:
         self._integral, self._integral_step = 0.0, -1
@@ -169,7 +170,7 @@ class TargetTask(Task):
             current += max(-per_step, min(per_step, waypoint - current))
         if self.family.relative:
             offsets += self.start_value
-        self._targets = offsets % 360.0 if self.family.angular else offsets
+        self._targets = wrap_360(offsets) if self.family.angular else offsets
 
     def target_value(self, step: int) -> float:
         targets = self._targets
@@ -179,7 +180,7 @@ class TargetTask(Task):
         """Target minus value at ``step`` (wrapped to [-180, 180) for angles)."""
         err = self.target_value(step) - value
         if self.family.angular:
-            err = (err + 180.0) % 360.0 - 180.0
+            err = wrap_180(err)
         return err
 
     def observe(self, state: np.ndarray, step: int) -> np.ndarray:
@@ -189,7 +190,7 @@ class TargetTask(Task):
         target = self.target_value(step)
         err = target - state[self._var]
         if self.family.angular:
-            err = (err + 180.0) % 360.0 - 180.0
+            err = wrap_180(err)
         if step > self._integral_step:  # once per step, however often it is observed
             missed = step - self._integral_step if self._integral_step >= 0 else 1
             limit = self._integral_limit
@@ -205,7 +206,7 @@ class TargetTask(Task):
         target = ctx.target if ctx.target is not None else self.target_value(ctx.step)
         err = target - ctx.state.values[self._var]
         if self.family.angular:
-            err = (err + 180.0) % 360.0 - 180.0
+            err = wrap_180(err)
         smooth = action_change(ctx.prev_action, ctx.action)
         return math.exp(-abs(err) / self.reward_scale) - SMOOTHNESS_WEIGHT * smooth
 

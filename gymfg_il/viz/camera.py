@@ -29,9 +29,9 @@ import numpy as np
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.scenery import Landmark
+from gymfg_il.units import FT_PER_DEG, wrap_180
 
 VIEWS = ("front", "chase")
-_FT_PER_DEG = math.pi / 180.0 * 20902230.97
 _SKY_HORIZON = np.array([200, 222, 240], dtype=np.float32)
 _SKY_ZENITH = np.array([60, 110, 190], dtype=np.float32)
 _HAZE = np.array([190, 205, 215], dtype=np.float32)
@@ -147,7 +147,7 @@ class Camera:
             rot = rotation(0.0, pitch, heading)
             eye = rot @ np.array([-_CHASE_FT[0], _CHASE_FT[1], _CHASE_FT[2]])
         image = self._background(
-            rot, lat * _FT_PER_DEG + eye[0], lon * _FT_PER_DEG * cos_lat + eye[1], agl - eye[2]
+            rot, lat * FT_PER_DEG + eye[0], lon * FT_PER_DEG * cos_lat + eye[1], agl - eye[2]
         )
         items = list(landmarks)
         if self.view == "chase":
@@ -215,8 +215,8 @@ class Camera:
             offset = (
                 np.array(
                     [
-                        (item.lat_deg - own[0]) * _FT_PER_DEG,
-                        ((item.lon_deg - own[1] + 180.0) % 360.0 - 180.0) * _FT_PER_DEG * cos_lat,
+                        (item.lat_deg - own[0]) * FT_PER_DEG,
+                        wrap_180(item.lon_deg - own[1]) * FT_PER_DEG * cos_lat,
                         own[2] - item.alt_ft,
                     ]
                 )
