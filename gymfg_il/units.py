@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, overload
 
 if TYPE_CHECKING:
     import numpy as np
+    import torch
 
 FT_TO_M = 0.3048  # the international foot
 KT_TO_MS = 1852.0 / 3600.0  # knots to m/s (a nautical mile is 1852 m)
@@ -31,6 +32,8 @@ FT_PER_DEG = DEG_TO_RAD * EARTH_RADIUS_FT  # feet per degree of latitude
 def wrap_180(angle_deg: float) -> float: ...
 @overload
 def wrap_180(angle_deg: np.ndarray) -> np.ndarray: ...
+@overload
+def wrap_180(angle_deg: torch.Tensor) -> torch.Tensor: ...
 def wrap_180(angle_deg: Any) -> Any:
     """``angle_deg`` folded into [-180, 180): the signed turn a difference of headings is."""
     return (angle_deg + 180.0) % 360.0 - 180.0
