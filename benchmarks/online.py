@@ -41,6 +41,11 @@ def client(
     batch_io: bool = True,
 ) -> None:
     """One team of one c172p flying ``steps`` lockstep steps; prints its steps/s."""
+    import logging
+
+    # the server's "waiting for N more teams to join" while the others start is the
+    # benchmark's start, not news: only errors are shown
+    logging.getLogger("gymfg_il.online").setLevel(logging.ERROR)
     from gymfg_il import Team
     from gymfg_il.aircraft import c172p
     from gymfg_il.controllers.autopilot import controller_for
