@@ -43,9 +43,8 @@ FUEL_TANKS = tuple(
 )
 
 
-# Rendering light enough that fgfs under Xvfb takes under one core and streams at ~26 Hz
-# (full rendering takes both cores here at ~6 fps, and every stream falls to ~5 Hz); use
-# with geometry="320x240"
+# Rendering light enough for fgfs under Xvfb to leave a core to the simulation (what it
+# costs against full rendering: docs/results/flightgear.md); use with geometry="320x240"
 LIGHTWEIGHT = (
     "--disable-clouds",
     "--disable-clouds3d",

@@ -7,11 +7,9 @@ motion and height read) fading into haze with distance; rays that point up see a
 from the horizon to the zenith. Landmarks (``tasks.scenery``: runways, gates, other
 aircraft) are projected and filled as convex polygons, far to near.
 
-Why not OpenGL: measured on this machine (2 cores, no GPU, ``benchmarks/camera.py``), this
-renderer draws 128x128 frames several times faster than an offscreen moderngl context on
-Mesa's software rasteriser once the read-back is counted, needs no system library, and is
-bit-for-bit deterministic: the same state gives the same frame, so datasets and tests
-reproduce.
+Why not OpenGL: this renderer needs no system library and is bit-for-bit deterministic (the
+same state gives the same frame, so datasets and tests reproduce); how its speed compares
+with an offscreen moderngl context is measured by ``benchmarks/camera.py`` (docs/results/vision.md).
 
 Views: ``front`` (the pilot's eye, 90 deg horizontal field of view, rolled and pitched with
 the aircraft) and ``chase`` (behind and above, turned with the heading and pitch but not the
@@ -60,8 +58,8 @@ def _palette() -> np.ndarray:
 
 
 _PALETTE = _palette()
-# the same colours as one uint32 (RGBA bytes) each: gathering 4-byte words is ~10x faster
-# than gathering rows of 3 bytes
+# the same colours as one uint32 (RGBA bytes) each: frames gather 4-byte words, not rows of
+# 3 bytes
 _PALETTE_RGBA = np.concatenate([_PALETTE, np.full((len(_PALETTE), 1), 255, np.uint8)], 1)
 _PALETTE_RGBA = _PALETTE_RGBA.view(np.uint32).ravel()
 # wing, fuselage seen from above and from the side, tailplane, fin
