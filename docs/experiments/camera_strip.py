@@ -1,7 +1,7 @@
-"""The README's frame strip: an approach flown by the task's expert, seen by the headless
-camera (front view above, chase view below) at six moments.
+"""The frame strip of the README and the camera guide: an approach flown by the task's expert,
+seen by the headless camera (front view above, chase view below) at six moments.
 
-    python docs/experiments/camera_strip.py [OUT.png]
+    python docs/experiments/camera_strip.py [OUT.png]   (default docs/images/camera_strip.png)
 """
 
 from __future__ import annotations
@@ -49,4 +49,4 @@ def main(out: Path, seed: int = 3, size: int = 160) -> None:
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1] if len(sys.argv) > 1 else "docs/camera_strip.png"))
+    main(Path(sys.argv[1] if len(sys.argv) > 1 else "docs/images/camera_strip.png"))

@@ -23,8 +23,8 @@ class KeyboardBindings:
     surfaces return to their neutral (the trim) at ``centering`` per second (0 = they stay).
 
     Attributes:
-        aileron_left, aileron_right, elevator_down, elevator_up, rudder_left, rudder_right,
-        throttle_up, throttle_down: key names, several per control allowed.
+        aileron_left, aileron_right, elevator_down, elevator_up: key names (several allowed).
+        rudder_left, rudder_right, throttle_up, throttle_down: key names (several allowed).
         center: key that centres the three surfaces at once.
         rate: surface travel per second while a key is held (full range = 2).
         throttle_rate: throttle travel per second while a key is held.

@@ -1,0 +1,1 @@
+"""Physics-based controllers: PIDs, the autopilots that fly each task, their gains."""

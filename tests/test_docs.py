@@ -1,0 +1,126 @@
+"""The documentation: the site builds with ``mkdocs build --strict`` (a broken link, anchor or
+API reference fails), its generated references cover the package, and every Python block of
+the site and the README runs as written."""
+
+import ast
+import importlib.util
+import os
+import re
+import socket
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+# a Python block, with the reason it is not run where the page says so
+BLOCK = re.compile(r"(?:<!-- not run here:([^\n]*?)-->\n)?```python\n(.*?)```", re.S)
+MKDOCS_ENV = {**os.environ, "NO_MKDOCS_2_WARNING": "1", "DISABLE_MKDOCS_2_WARNING": "true"}
+
+
+def blocks(page: Path) -> list[tuple[str | None, str]]:
+    """(why it is not run, or None; the code) of every Python block of ``page``, in order."""
+    return [(m.group(1), m.group(2)) for m in BLOCK.finditer(page.read_text())]
+
+
+def name(page: Path) -> str:
+    return str(page.relative_to(ROOT))
+
+
+def mkdocs_build(config: Path, site: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "-f", str(config), "-d", str(site)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        env=MKDOCS_ENV,
+        timeout=600,
+    )
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory):
+    site = tmp_path_factory.mktemp("site")
+    run = mkdocs_build(ROOT / "mkdocs.yml", site)
+    assert run.returncode == 0, run.stderr[-6000:]
+    return site
+
+
+def test_the_site_builds_strictly_with_a_page_per_module_and_command(site):
+    spec = importlib.util.spec_from_file_location("walk", ROOT / "docs/generate/package_walk.py")
+    walk = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(walk)
+    missing = [
+        ".".join(parts)
+        for parts, _, tree in walk.modules()
+        if not walk.is_shim(tree) and not (site / "reference/api" / Path(*parts[1:])).is_dir()
+    ]
+    assert not missing, f"no API page for {missing}"
+    deprecated = (site / "reference/api/deprecated/index.html").read_text()
+    assert "gymfg_il.controllers.agent" in deprecated  # an old path, with its new home
+    train = (site / "reference/cli/train/index.html").read_text()
+    assert "--epochs" in train and "--dataset" in train  # flags from TrainConfig's fields
+
+
+def test_a_broken_link_fails_the_build(tmp_path):
+    docs = tmp_path / "docs"
+    docs.mkdir()
+    (docs / "index.md").write_text("# Home\n\nSee [the guide](guides/nowhere.md).\n")
+    config = tmp_path / "mkdocs.yml"
+    config.write_text(
+        f"INHERIT: {ROOT / 'mkdocs.yml'}\ndocs_dir: {docs}\nplugins: [search]\nnav: [index.md]\n"
+    )
+    run = mkdocs_build(config, tmp_path / "site")
+    assert run.returncode != 0
+    assert "guides/nowhere.md" in run.stderr
+
+
+def test_every_block_that_is_not_run_says_why():
+    marks = {name(p): len(re.findall("^<!-- not run here:", p.read_text(), re.M)) for p in PAGES}
+    said = {name(p): sum(1 for why, _ in blocks(p) if why and why.strip()) for p in PAGES}
+    assert said == marks  # each mark directly precedes a Python block, with a reason
+
+
+@pytest.mark.parametrize(
+    "page", [p for p in PAGES if any(why is None for why, _ in blocks(p))], ids=name
+)
+def test_the_python_blocks_of_a_page_run_in_order(page, tmp_path, monkeypatch):
+    for folder in ("datasets", "collectors"):  # the checkout's data, read where pages read it
+        (tmp_path / folder).symlink_to(ROOT / folder)
+    monkeypatch.chdir(tmp_path)
+    namespace: dict[str, object] = {"__name__": "__main__"}
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", ".* has moved to ", DeprecationWarning)
+        for i, (why, code) in enumerate(blocks(page)):
+            if why is None:
+                exec(compile(code, f"{name(page)}, block {i + 1}", "exec"), namespace)
+
+
+@pytest.mark.network
+def test_the_online_block_flies_two_teams_against_a_real_server(tmp_path):
+    (snippet,) = [c for _, c in blocks(ROOT / "docs/guides/online.md") if "threading" in c]
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    server = subprocess.Popen(
+        [sys.executable, "-m", "gymfg_il.serve", "--mode", "fixed", "--teams", "2",
+         "--secret", "s3cret", "--port", str(port)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    try:
+        assert b"serving" in server.stdout.readline()
+        script = tmp_path / "snippet.py"
+        script.write_text(snippet.replace("5555", str(port)))
+        run = subprocess.run(
+            [sys.executable, str(script)], capture_output=True, text=True, timeout=120
+        )
+        assert run.returncode == 0, run.stderr
+        seen = ast.literal_eval(run.stdout.strip().splitlines()[-1])
+        assert seen == {"red": 1, "blue": 1}
+    finally:
+        server.terminate()
+        server.wait(5)
