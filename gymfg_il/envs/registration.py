@@ -2,32 +2,32 @@
 
 ``gymnasium.make("GymFG/Altitude-v0", aircraft="f15", dynamic=True,
 task_kwargs={"target_range": (-500, 500)})``.
+
+The ids follow the task registry (``tasks.library.TASK_FAMILIES``): a family's name in
+CamelCase (``climb-turn`` is ``GymFG/ClimbTurn-v0``), ``level`` is ``GymFG/LevelFlight-v0``.
 """
 
 from __future__ import annotations
 
 import gymnasium as gym
 
+from gymfg_il.tasks.library import TASK_FAMILIES
+
 ENTRY_POINT = "gymfg_il.envs.single:AircraftEnv"
-IDS: dict[str, str] = {
-    "GymFG/Altitude-v0": "altitude",
-    "GymFG/Roll-v0": "roll",
-    "GymFG/Pitch-v0": "pitch",
-    "GymFG/Heading-v0": "heading",
-    "GymFG/Airspeed-v0": "airspeed",
-    "GymFG/Sideslip-v0": "sideslip",
-    "GymFG/LevelFlight-v0": "level",
-    "GymFG/Dummy-v0": "dummy",
-    "GymFG/Turn-v0": "turn",
-    "GymFG/ClimbTurn-v0": "climb-turn",
-    "GymFG/Waypoints-v0": "waypoints",
-    "GymFG/Formation-v0": "formation",
-    "GymFG/Approach-v0": "approach",
-}
+ID_NAMES = {"level": "LevelFlight"}  # where an id says more than the family's short name
+
+
+def env_id(family: str) -> str:
+    """The gymnasium id of a task family."""
+    name = ID_NAMES.get(family) or "".join(w.capitalize() for w in family.split("-"))
+    return f"GymFG/{name}-v0"
+
+
+IDS: dict[str, str] = {env_id(family): family for family in TASK_FAMILIES}
 
 
 def register_envs() -> None:
     """Register every id once (importing ``gymfg_il`` calls this)."""
-    for env_id, family in IDS.items():
-        if env_id not in gym.registry:
-            gym.register(env_id, entry_point=ENTRY_POINT, kwargs={"task": family})
+    for name, family in IDS.items():
+        if name not in gym.registry:
+            gym.register(name, entry_point=ENTRY_POINT, kwargs={"task": family})

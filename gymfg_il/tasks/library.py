@@ -227,7 +227,9 @@ class LevelFlightTask(Task):
         )
 
 
-# Task families by the short names the CLI and env ids use: (static, dynamic).
+# The registry of task names: each family by the short name the CLI, the recipes and the env
+# ids use -> (static, dynamic) (a task without a dynamic variant gives its class twice). Every
+# list of task names (the maneuvers, the tasks with a target, the gymnasium ids) derives from it.
 TASK_FAMILIES: dict[str, tuple[type[Task], type[Task]]] = {
     "altitude": (ReachStaticTargetAltitudeTask, ReachDynamicTargetAltitudeTask),
     "roll": (ReachStaticTargetRollTask, ReachDynamicTargetRollTask),
@@ -240,17 +242,22 @@ TASK_FAMILIES: dict[str, tuple[type[Task], type[Task]]] = {
 }
 
 
-def _add_maneuvers() -> None:
+def _add_maneuvers() -> tuple[str, ...]:
+    """Register the maneuvers (they import this module's tasks); their names, in order."""
     from gymfg_il.tasks.courses import ApproachTask, WaypointsTask
     from gymfg_il.tasks.formation import FormationTask
     from gymfg_il.tasks.maneuvers import ClimbTurnTask, TurnTask
 
-    for cls in (TurnTask, ClimbTurnTask, WaypointsTask, FormationTask, ApproachTask):
+    added = (TurnTask, ClimbTurnTask, WaypointsTask, FormationTask, ApproachTask)
+    for cls in added:
         TASK_FAMILIES[cls.name] = (cls, cls)
+    return tuple(cls.name for cls in added)
 
 
-_add_maneuvers()
-MANEUVERS = ("turn", "climb-turn", "waypoints", "formation", "approach")
+MANEUVERS = _add_maneuvers()
+# the tasks that bring a variable to a target (``Task.tracked``): what the controllers fly,
+# demonstrations show and ``eval`` scores (every family but ``dummy``)
+TRACKED_TASKS = tuple(n for n, (cls, _) in TASK_FAMILIES.items() if cls.tracked is not Task.tracked)
 assert set(FAMILIES) <= set(TASK_FAMILIES)
 # other names people look for a family by (the paper names the rudder's controller)
 TASK_ALIASES = {"rudder": "sideslip"}
