@@ -24,8 +24,17 @@ SUPPRESS = argparse.SUPPRESS
 
 
 def field_docs(cls: type) -> dict[str, str]:
-    """Field name -> its line(s) in the ``Attributes:`` section of ``cls``'s docstring."""
-    doc = cls.__doc__ or ""
+    """Field name -> its line(s) in the ``Attributes:`` section of the docstring of ``cls``,
+    or of the base class that declares the field (a config built on ``FlightOptions`` takes
+    its flight options' docs from there)."""
+    docs: dict[str, str] = {}
+    for klass in reversed(cls.__mro__):
+        if "__doc__" in vars(klass) and dataclasses.is_dataclass(klass):
+            docs.update(_attributes(klass.__doc__ or ""))
+    return {k: v.replace("``", "") for k, v in docs.items()}
+
+
+def _attributes(doc: str) -> dict[str, str]:
     section = doc.split("Attributes:", 1)[1] if "Attributes:" in doc else ""
     docs: dict[str, str] = {}
     current = None
@@ -36,7 +45,7 @@ def field_docs(cls: type) -> dict[str, str]:
             docs[current] = m.group(2).strip()
         elif current and line.strip():
             docs[current] += " " + line.strip()
-    return {k: v.replace("``", "") for k, v in docs.items()}
+    return docs
 
 
 def summary(cls: type) -> str:
@@ -71,14 +80,16 @@ def add_fields(
     skip: tuple[str, ...] = (),
     defaults: Mapping[str, Any] | None = None,
     flags: Mapping[str, str] | None = None,
+    shown: Mapping[str, str] | None = None,
     overrides_only: bool = False,
 ) -> None:
     """One flag per field of the dataclass ``cls`` (``only``/``skip`` choose the fields;
     ``defaults`` and ``flags`` change a field's default and flag name for this command;
+    ``shown`` says in words what a field left out means, e.g. "the policy's";
     ``overrides_only``: a flag left out is absent from the namespace, e.g. recipe overrides)."""
     docs = field_docs(cls)
     hints = typing.get_type_hints(cls)
-    defaults, flags = dict(defaults or {}), dict(flags or {})
+    defaults, flags, shown = dict(defaults or {}), dict(flags or {}), dict(shown or {})
     for f in dataclasses.fields(cls):
         if f.name in skip or (only is not None and f.name not in only):
             continue
@@ -93,9 +104,10 @@ def add_fields(
             kind, origin = args[0], typing.get_origin(args[0])
             args = list(typing.get_args(args[0]))
         text = docs.get(f.name, "")
-        if default is not None and default != [] and default != {}:
-            shown = default.__name__ if isinstance(default, type) else default
-            text += f" (default: {shown})"
+        if f.name in shown:
+            text += f" (default: {shown[f.name]})"
+        elif default is not None and default != [] and default != {}:
+            text += f" (default: {default.__name__ if isinstance(default, type) else default})"
         options: dict[str, Any] = {
             "help": text.replace("%", "%%"),
             "default": SUPPRESS if overrides_only else default,

@@ -122,32 +122,18 @@ class FlightSpec:
 
     # -- solo flights ------------------------------------------------------------------
     @classmethod
-    def solo(
-        cls,
-        aircraft: str = "c172p",
-        task: str = "altitude",
-        *,
-        dynamic: bool = False,
-        task_kwargs: Mapping[str, Any] | None = None,
-        agent_hz: int = DEFAULT_AGENT_HZ,
-        sim_hz: int = DEFAULT_SIM_HZ,
-        episode_time_s: float | None = None,
-        turbulence: Turbulence = "none",
-        wind_kt: float = 0.0,
-        wind_from_deg: float | None = None,
-        trimmed_starts: bool = True,
-    ) -> FlightSpec:
+    def solo(cls, aircraft: str = "c172p", task: str = "altitude", **options: Any) -> FlightSpec:
         """One aircraft, callsign ``ego``, flying one task (what the gymnasium env flies);
-        ``episode_time_s`` defaults to the task's own (90 s for most, longer for the
-        maneuvers that need it)."""
-        ego = AircraftSpec(aircraft, "ego", task, dynamic, dict(task_kwargs or {}))
-        if episode_time_s is None:
-            episode_time_s = task_class(task, dynamic).episode_time_s
-        teams = (TeamSpec("ego", (ego,)),)
-        return cls(
-            teams, agent_hz, sim_hz, episode_time_s, DEFAULT_OPPONENT_VIEW, None, turbulence,
-            wind_kt, wind_from_deg, trimmed_starts,
-        )  # fmt: skip
+        ``options`` are the other ``FlightOptions`` (``dynamic``, ``task_kwargs``,
+        ``agent_hz``, ``sim_hz``, ``episode_time_s``: by default the task's own, 90 s for most,
+        longer for the maneuvers that need it; ``turbulence``, ``wind_kt``, ``wind_from_deg``,
+        ``trimmed_starts``)."""
+        from gymfg_il.envs.options import FlightOptions, options_problem
+
+        problem = options_problem(options)
+        if problem is not None:
+            raise problem
+        return FlightOptions(aircraft=aircraft, task=task, **options).flight()
 
     @property
     def is_solo(self) -> bool:
@@ -292,16 +278,16 @@ class FlightSpec:
         config = world.config
         weather = config.weather
         return cls(
-            tuple(teams),
-            config.agent_hz,
-            config.sim_hz,
-            world.max_steps / config.agent_hz,
-            config.opponent_view,
-            scenario_record(config.scenario),
-            weather.turbulence,
-            weather.wind_kt,
-            weather.wind_from_deg,
-            config.trimmed_starts,
+            teams=tuple(teams),
+            agent_hz=config.agent_hz,
+            sim_hz=config.sim_hz,
+            episode_time_s=world.max_steps / config.agent_hz,
+            opponent_view=config.opponent_view,
+            scenario=scenario_record(config.scenario),
+            turbulence=weather.turbulence,
+            wind_kt=weather.wind_kt,
+            wind_from_deg=weather.wind_from_deg,
+            trimmed_starts=config.trimmed_starts,
         )
 
     def rebuild_problems(self) -> list[str]:
@@ -353,13 +339,13 @@ class FlightSpec:
     ) -> EnvConfig:
         """The environment settings (``scenario`` replaces a recorded one of your own)."""
         return EnvConfig(
-            self.sim_hz,
-            self.agent_hz,
-            self.opponent_view,
-            scenario if scenario is not None else scenario_from_record(self.scenario),
-            views,
-            traffic,
-            self.weather,
+            sim_hz=self.sim_hz,
+            agent_hz=self.agent_hz,
+            opponent_view=self.opponent_view,
+            scenario=scenario if scenario is not None else scenario_from_record(self.scenario),
+            views=views,
+            traffic=traffic,
+            weather=self.weather,
             trimmed_starts=self.trimmed_starts,
         )
 

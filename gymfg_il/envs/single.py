@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -11,15 +12,14 @@ import numpy as np
 
 from gymfg_il.aircraft import Aircraft
 from gymfg_il.envs.actions import controls
-from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.options import FlightOptions, options_problem
 from gymfg_il.envs.team import Team
 from gymfg_il.envs.world import World
 from gymfg_il.errors import ConfigError, EnvStateError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
-from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ
-from gymfg_il.sim.weather import Turbulence, Weather
+from gymfg_il.sim.timing import DEFAULT_AGENT_HZ
 from gymfg_il.tasks.base import Task
 from gymfg_il.tasks.scenery import landmarks_of
 from gymfg_il.tasks.targets import TargetTask
@@ -32,21 +32,23 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
 
     Args:
         task: a task name (``altitude``, ``roll``, ``pitch``, ``heading``, ``airspeed``,
-            ``level``, ``dummy``), a Task class, or a configured Task instance.
+            ``sideslip``, ``level``, ``dummy``, or a maneuver: ``turn``, ``climb-turn``,
+            ``waypoints``, ``formation``, ``approach``), a task of your own by import path
+            (``package.module:ClassName``), a Task class, or a configured Task instance.
         aircraft: JSBSim model (``c172p``, ``f15``, ``A320``, any of
             ``gymfg_il.aircraft.available_models()``).
-        dynamic: use the family's dynamic (moving) target instead of a static one.
-        task_kwargs: arguments of the task class, e.g. ``{"target_range": (-500, 500)}``.
-        agent_hz: agent rate (Hz), an exact divisor of ``sim_hz``.
-        sim_hz: JSBSim rate (Hz).
-        episode_time_s: episode length; reaching it sets ``truncated`` (default: the task's
-            own, 90 s for most tasks).
-        views: UDP ports of FlightGear views of the aircraft (``flightgear.launcher``); with a view
-            attached the env runs at real time.
-        turbulence, wind_kt, wind_from_deg: the weather (``sim.weather``): JSBSim's
-            turbulence (none, light, moderate, severe) and a steady wind, seeded per episode.
-        trimmed_starts: start each episode in trimmed straight, level flight, the controls
-            at the trim (the default; ``sim.trim``), or untrimmed with centred surfaces.
+        options: the other flight options, as keywords (``envs.options.FlightOptions``):
+            ``dynamic`` (the family's moving target instead of a static one),
+            ``task_kwargs`` (arguments of the task class, e.g. ``{"target_range": (-500,
+            500)}``), ``agent_hz`` (an exact divisor of ``sim_hz``), ``sim_hz`` (JSBSim's
+            rate), ``episode_time_s`` (reaching it sets ``truncated``; default: the task's
+            own, 90 s for most tasks), ``turbulence``, ``wind_kt`` and ``wind_from_deg``
+            (the weather, ``sim.weather``: JSBSim's turbulence, none, light, moderate or
+            severe, and a steady wind, seeded per episode) and ``trimmed_starts`` (start
+            each episode in trimmed straight, level flight, the controls at the trim: the
+            default, ``sim.trim``; False: untrimmed with centred surfaces).
+        views: UDP ports of FlightGear views of the aircraft (``flightgear.launcher``); with a
+            view attached the env runs at real time.
         render_mode: ``None``, ``"rgb_array"`` (``render()`` returns the camera's frame,
             (height, width, 3) uint8) or ``"human"`` (a window shows it at every reset and
             step, paced to real time at ``metadata["render_fps"]`` = ``agent_hz``).
@@ -76,64 +78,29 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         task: str | type[Task] | Task = "altitude",
         aircraft: str = "c172p",
         *,
-        dynamic: bool = False,
-        task_kwargs: Mapping[str, Any] | None = None,
-        agent_hz: int = DEFAULT_AGENT_HZ,
-        sim_hz: int = DEFAULT_SIM_HZ,
-        episode_time_s: float | None = None,
-        render_mode: str | None = None,
         views: Sequence[int] | None = None,
-        turbulence: Turbulence = "none",
-        wind_kt: float = 0.0,
-        wind_from_deg: float | None = None,
-        trimmed_starts: bool = True,
+        render_mode: str | None = None,
         camera: str = "front",
         render_size: tuple[int, int] = (128, 128),
+        **options: Any,
     ) -> None:
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ConfigError(
                 f"render_mode={render_mode!r} is not supported; use None, 'rgb_array' or 'human'"
             )
-        kwargs = dict(task_kwargs or {})
+        problem = options_problem(options)
+        if problem is not None:
+            raise problem
+        flight_options = FlightOptions(aircraft=aircraft, **options)
+        seen = {"ego": list(views)} if views else None
         flight: FlightSpec | None = None
         if isinstance(task, str):
-            flight = FlightSpec.solo(
-                aircraft,
-                task,
-                dynamic=dynamic,
-                task_kwargs=kwargs,
-                agent_hz=agent_hz,
-                sim_hz=sim_hz,
-                episode_time_s=episode_time_s,
-                turbulence=turbulence,
-                wind_kt=wind_kt,
-                wind_from_deg=wind_from_deg,
-                trimmed_starts=trimmed_starts,
-            )
-            team = flight.build_teams()[0]
+            flight = dataclasses.replace(flight_options, task=task).flight()
+            self.world = World(flight.build_teams(), flight.env_config(views=seen))
         else:
-            if isinstance(task, type) and issubclass(task, Task):
-                spec: Any = functools.partial(task, **kwargs)
-            elif isinstance(task, Task):
-                if kwargs:
-                    raise ConfigError("task_kwargs apply to a task name or class, not an instance")
-                spec = task
-            else:
-                raise ConfigError(f"task={task!r} must be a family name, a Task class or instance")
-            cls = task if isinstance(task, type) else type(task)
-            seconds = cls.episode_time_s if episode_time_s is None else episode_time_s
-            team = Team("ego", [(Aircraft(aircraft, "ego"), spec)], episode_time_s=seconds)
-        self.aircraft = team.aircraft[0]
-        self.world = World(
-            [team],
-            EnvConfig(
-                sim_hz=sim_hz,
-                agent_hz=agent_hz,
-                views={"ego": list(views)} if views else None,
-                weather=Weather(turbulence, wind_kt, wind_from_deg),
-                trimmed_starts=trimmed_starts,
-            ),
-        )
+            team = _team_flying(task, aircraft, flight_options)
+            self.world = World([team], flight_options.env_config(views=seen))
+        self.aircraft = self.world.teams[0].aircraft[0]
         self.flight = flight or FlightSpec.of_world(self.world)
         self._slot = self.world.slots[0]
         self.task = self._slot.task
@@ -142,7 +109,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         self.action_space = gym.spaces.Box(ACTION_LOW, ACTION_HIGH, dtype=np.float32)
         self.observation_names = self.task.observation_names
         self.render_mode = render_mode
-        self.metadata = {**type(self).metadata, "render_fps": agent_hz}
+        self.metadata = {**type(self).metadata, "render_fps": self.world.config.agent_hz}
         self.camera = Camera(*render_size, view=camera)
         self._window: FrameWindow | None = None
         self._cameras: dict[tuple[str, int], Camera] = {}
@@ -153,22 +120,7 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         cls, flight: FlightSpec, views: Sequence[int] | None = None, **kwargs: Any
     ) -> AircraftEnv:
         """The env of a solo flight spec (``kwargs``: render_mode, camera, render_size)."""
-        ego = flight.solo_aircraft
-        return cls(
-            ego.task,
-            ego.model,
-            dynamic=ego.dynamic,
-            task_kwargs=ego.task_kwargs,
-            agent_hz=flight.agent_hz,
-            sim_hz=flight.sim_hz,
-            episode_time_s=flight.episode_time_s,
-            views=views,
-            turbulence=flight.turbulence,
-            wind_kt=flight.wind_kt,
-            wind_from_deg=flight.wind_from_deg,
-            trimmed_starts=flight.trimmed_starts,
-            **kwargs,
-        )
+        return cls(views=views, **FlightOptions.of(flight).given(), **kwargs)
 
     @property
     def dt(self) -> float:
@@ -256,3 +208,20 @@ class AircraftEnv(gym.Env[np.ndarray, np.ndarray]):
         if self.world.slots:
             self.world.close()
             self.world.pool.close()
+
+
+def _team_flying(task: type[Task] | Task, aircraft: str, options: FlightOptions) -> Team:
+    """The one-aircraft team of a task given as a class (built with ``task_kwargs``) or as
+    an instance."""
+    kwargs = dict(options.task_kwargs or {})
+    if isinstance(task, type) and issubclass(task, Task):
+        spec: Any = functools.partial(task, **kwargs)
+    elif isinstance(task, Task):
+        if kwargs:
+            raise ConfigError("task_kwargs apply to a task name or class, not an instance")
+        spec = task
+    else:
+        raise ConfigError(f"task={task!r} must be a family name, a Task class or instance")
+    cls = task if isinstance(task, type) else type(task)
+    seconds = cls.episode_time_s if options.episode_time_s is None else options.episode_time_s
+    return Team("ego", [(Aircraft(aircraft, "ego"), spec)], episode_time_s=seconds)
