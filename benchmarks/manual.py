@@ -18,8 +18,8 @@ def manual_loop(seconds: float) -> Row:
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     import pygame
 
+    from gymfg_il.collectors.config import ManualConfig
     from gymfg_il.collectors.manual import ManualSession
-    from gymfg_il.envs.flight import FlightSpec
 
     frames = int(seconds * 30)
     keys = [pygame.K_LEFT, pygame.K_UP, pygame.K_RIGHT, pygame.K_DOWN]
@@ -35,8 +35,8 @@ def manual_loop(seconds: float) -> Row:
         pygame.event.post(pygame.event.Event(kind, key=key, mod=0, unicode="", scancode=0))
 
     with tempfile.TemporaryDirectory() as tmp:
-        flight = FlightSpec.solo(episode_time_s=seconds + 5, agent_hz=30)
-        stats = ManualSession(flight, Path(tmp), on_frame=on_frame).run(max_frames=frames)
+        cfg = ManualConfig(episode_time_s=seconds + 5, agent_hz=30, episodes=0, out=Path(tmp))
+        stats = ManualSession(cfg, on_frame).run(max_frames=frames)
     errors = np.abs(np.array(stats.periods[2:]) - 1 / 30) * 1000
     return Row(
         "manual_loop_p99_period_error_ms",
@@ -57,16 +57,15 @@ def synthetic_pilot(seconds: float) -> Row:
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     import time
 
+    from gymfg_il.collectors.config import ManualConfig
     from gymfg_il.collectors.manual import ManualSession
-    from gymfg_il.collectors.synthetic import SyntheticDriver
-    from gymfg_il.envs.flight import FlightSpec
 
     with tempfile.TemporaryDirectory() as tmp:
-        flight = FlightSpec.solo(episode_time_s=seconds, agent_hz=30)
-        session = ManualSession(
-            flight, Path(tmp), on_frame=SyntheticDriver(), realtime=False, source="synthetic",
-            draw=False, build_each=False, max_episodes=2,
-        )  # fmt: skip
+        cfg = ManualConfig(
+            episode_time_s=seconds, agent_hz=30, pilot="synthetic", episodes=2, out=Path(tmp)
+        )
+        flight = cfg.flight()
+        session = ManualSession(cfg)
         started = time.perf_counter()
         stats = session.run()
         wall = time.perf_counter() - started

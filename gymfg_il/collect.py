@@ -18,19 +18,18 @@ and ``dataset/`` (LeRobot v3.0). Collecting into an existing folder appends.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from gymfg_il.collectors.config import ManualConfig
 
 EPILOG = __doc__.split("\n\n", 1)[1]
-FLIGHT = ("aircraft", "task", "dynamic", "episode_time_s", "seed", "turbulence", "wind_kt")
-CAMERA = ("images", "image_size")
-AUTOPILOT = (*FLIGHT, "episodes", "agent_hz", "noise", "out", *CAMERA)
-MANUAL = (
-    *FLIGHT, "device", "agent_hz", "episodes", "assist", "out", "view", "pilot", "skill",
-    *CAMERA, "pilot_view",
-)  # fmt: skip
-RECIPE = tuple(dict.fromkeys(AUTOPILOT + MANUAL))
+# a person's session: smooth at 30 Hz, until they quit, into a folder of its own
+MANUAL_DEFAULTS = {"agent_hz": 30, "episodes": 0, "out": Path("datasets/manual")}
 
 
 def _workers(text: str) -> int:
@@ -67,7 +66,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         RepairConfig,
         ReplayConfig,
     )
-    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.collectors.config import CollectConfig, ManualConfig
+    from gymfg_il.envs.options import TASK_OWN_TIME, unset_values
     from gymfg_il.learning.dagger import DaggerConfig
 
     if argv and argv[0].endswith(".toml"):
@@ -76,7 +76,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
             "Run a collection recipe (collectors/*.toml); options override the recipe.",
         )
         r.add_argument("recipe", type=Path)
-        cli.add_fields(r, CollectConfig, only=RECIPE, overrides_only=True)
+        cli.add_fields(r, ManualConfig, overrides_only=True)
         r.add_argument(
             "--fps", dest="agent_hz", type=int, default=cli.SUPPRESS, help="the same as --agent-hz"
         )
@@ -94,8 +94,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         dest="command",
         metavar="{autopilot,manual,dagger,recover,repair,replay,reindex,export,RECIPE.toml}",
     )
+    # a flight option left out is the flight's default, shown as such
+    unset, shown = unset_values(), {"episode_time_s": TASK_OWN_TIME}
     auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
-    cli.add_fields(auto, CollectConfig, only=AUTOPILOT)
+    cli.add_fields(auto, CollectConfig, defaults=unset, shown=shown)
     _running(auto)
     manual = sub.add_parser(
         "manual",
@@ -106,9 +108,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     )
     cli.add_fields(
         manual,
-        CollectConfig,
-        only=MANUAL,
-        defaults={"agent_hz": 30, "episodes": 0, "out": Path("datasets/manual")},
+        ManualConfig,
+        skip=("noise",),  # the autopilot's
+        defaults={**unset, **MANUAL_DEFAULTS},
+        shown=shown,
         flags={"agent_hz": "--fps"},
     )
     manual.add_argument(
@@ -161,22 +164,19 @@ def _autopilot(args: argparse.Namespace) -> int:
     from gymfg_il import cli
     from gymfg_il.collectors.autopilot import collect_autopilot
     from gymfg_il.collectors.commands import report_build
-    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.collectors.config import CollectConfig, ManualConfig
     from gymfg_il.errors import ConfigError
 
     if args.command == "recipe":
-        options = {k: v for k, v in vars(args).items() if k in RECIPE}
+        known = {f.name for f in dataclasses.fields(ManualConfig)}
+        options = {k: v for k, v in vars(args).items() if k in known}
         cfg = CollectConfig.from_recipe(args.recipe, **options)
-        if cfg.kind == "manual":
+        if isinstance(cfg, ManualConfig):
             if "noise" in options or args.workers != 1 or args.ray:
                 raise ConfigError(
                     "--noise, --workers and --ray apply to autopilot recipes, not manual"
                 )
             return _fly_by_hand(cfg, not args.no_progress)
-        manual_only = sorted(set(options) & (set(MANUAL) - set(AUTOPILOT)))
-        if manual_only:
-            flags = ", ".join("--" + k.replace("_", "-") for k in manual_only)
-            raise ConfigError(f"{flags} apply to manual recipes; {args.recipe} is an autopilot one")
     else:
         cfg = cli.build(CollectConfig, args)
     show = not args.no_progress
@@ -207,21 +207,26 @@ def _autopilot(args: argparse.Namespace) -> int:
 
 def _manual(args: argparse.Namespace) -> int:
     from gymfg_il import cli
-    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.collectors.config import ManualConfig
 
-    return _fly_by_hand(cli.build(CollectConfig, args, kind="manual"), not args.no_progress)
+    return _fly_by_hand(cli.build(ManualConfig, args), not args.no_progress)
 
 
-def _fly_by_hand(cfg: object, show_progress: bool = True) -> int:
+def _fly_by_hand(cfg: ManualConfig, show_progress: bool = True) -> int:
     import os
 
     from gymfg_il import cli
-    from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.collectors.manual import ManualSession
 
-    assert isinstance(cfg, CollectConfig)
-    synthetic: dict[str, object] = {}
-    if cfg.pilot == "synthetic":  # headless, as fast as the machine allows
+    if cfg.pilot == "person":
+        session = ManualSession(cfg)
+        print(  # say in the terminal too what the session waits for
+            "the window is open: Space in it starts an episode, E saves it, Backspace "
+            "discards it, Q quits (H: help)",
+            flush=True,
+        )
+        stats = session.run()
+    else:  # the synthetic pilot: headless, as fast as the machine allows
         from gymfg_il.collectors.synthetic import SyntheticDriver
 
         os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
@@ -232,42 +237,10 @@ def _fly_by_hand(cfg: object, show_progress: bool = True) -> int:
             driver(frame, session)
             bar.update(session.stats.saved - bar.n)
 
-        synthetic = {
-            "on_frame": fly,
-            "realtime": False,
-            "source": "synthetic",
-            "draw": False,
-            "build_each": False,
-        }
-    session = ManualSession(
-        cfg.flight(),
-        cfg.out,
-        cfg.device,
-        {
-            "keyboard": cfg.keyboard,
-            "mouse": cfg.mouse,
-            "joystick": cfg.joystick,
-            "flightgear": cfg.flightgear,
-        },
-        cfg.assist,
-        cfg.seed,
-        cfg.episodes,
-        views=tuple(cfg.view),
-        images=cfg.images,
-        image_size=cfg.image_size,
-        pilot_view=None if cfg.pilot_view == "none" else cfg.pilot_view,
-        **synthetic,  # type: ignore[arg-type]
-    )
-    if not synthetic:  # say in the terminal too what the session waits for
-        print(
-            "the window is open: Space in it starts an episode, E saves it, Backspace "
-            "discards it, Q quits (H: help)",
-            flush=True,
-        )
-    try:
-        stats = session.run()
-    finally:
-        if synthetic:
+        session = ManualSession(cfg, fly)
+        try:
+            stats = session.run()
+        finally:
             bar.update(session.stats.saved - bar.n)
             bar.close()
     print(

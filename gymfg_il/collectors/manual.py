@@ -1,27 +1,30 @@
-"""The manual collection session: a person flies, in real time, and every completed episode
-becomes data at once.
+"""The manual collection session: a person (or the synthetic pilot) flies, in real time, and
+every completed episode becomes data at once.
 
-Keys (also shown by the help overlay, H): Space starts an episode, E ends and saves it,
-Backspace discards it (the same case is flown again), P pauses, T takes over from the assisting
-controller or policy and hands back, Q or Esc quits. Each completed episode is made durable in
-the MCAP log and then added to the LeRobot dataset before the next one starts, so quitting or a
-crash loses nothing completed.
+Keys (``collectors.manual_keys``; also shown by the help overlay, H): Space starts an episode,
+E ends and saves it, Backspace discards it (the same case is flown again), P pauses, T takes
+over from the assisting controller or policy and hands back, Q or Esc quits. Each completed
+episode is made durable in the MCAP log and then added to the LeRobot dataset before the next
+one starts, so quitting or a crash loses nothing completed. What the window shows is
+``collectors.manual_view``.
 """
 
 from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from gymfg_il.collectors.config import ManualConfig
+from gymfg_il.collectors.manual_keys import COMMAND_KEYS, help_lines
+from gymfg_il.collectors.manual_view import window_frame
 from gymfg_il.collectors.session import DATASET, check_appendable, check_out_folder
 from gymfg_il.collectors.updater import DatasetUpdater
-from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.manual.bindings import (
@@ -33,34 +36,17 @@ from gymfg_il.manual.bindings import (
 )
 from gymfg_il.manual.controller import ManualController
 from gymfg_il.manual.devices import check_person_can_fly
-from gymfg_il.manual.gui import ControlsGUI, GuiFrame
+from gymfg_il.manual.gui import ControlsGUI
 from gymfg_il.manual.takeover import Takeover
 from gymfg_il.recording.recorder import new_log_path
 from gymfg_il.recording.session import session_record
 from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.loop import Rollout
-from gymfg_il.sim.properties import BY_NAME, INDEX
-from gymfg_il.tasks.scenery import landmarks_of
 from gymfg_il.viz.camera import Camera
 
 log = logging.getLogger(__name__)
-
-COMMAND_KEYS = {
-    "space": "start",
-    "e": "end",
-    "backspace": "discard",
-    "p": "pause",
-    "t": "takeover",
-    "q": "quit",
-    "escape": "quit",
-    "h": "help",
-    "f1": "help",
-}
-SHOWN = (
-    "altitude_ft", "airspeed_kts", "vertical_speed_fps", "heading_deg", "roll_deg", "pitch_deg",
-    "alpha_deg", "beta_deg", "thrust_lbs",
-)  # fmt: skip
+FrameHook = Callable[[int, "ManualSession"], None]
 
 
 def _check_assist_rate(meta: dict[str, Any], flight: FlightSpec, path: Path) -> None:
@@ -74,33 +60,6 @@ def _check_assist_rate(meta: dict[str, Any], flight: FlightSpec, path: Path) -> 
         )
 
 
-def help_lines(device: str, kb: KeyboardBindings) -> list[str]:
-    def keys(names: list[str]) -> str:
-        return " / ".join(names)
-
-    lines = [
-        "SESSION  Space: start episode   E: end + save   Backspace: discard + fly again",
-        "         P: pause   T: take over / hand back   Q or Esc: quit   H: this help",
-    ]
-    if device == "mouse":
-        lines.append("STICK    the mouse pointer (offset from the window centre)")
-    elif device == "joystick":
-        lines.append("STICK    joystick axes (see the recipe's [collector.joystick])")
-    elif device == "flightgear":
-        return [*lines, "CONTROLS FlightGear's cockpit (its --native-ctrls stream)"]
-    else:
-        lines += [
-            f"AILERON  {keys(kb.aileron_left)}  |  {keys(kb.aileron_right)}",
-            f"ELEVATOR {keys(kb.elevator_down)} (nose down)  |  {keys(kb.elevator_up)} (nose up)",
-        ]
-    lines += [
-        f"RUDDER   {keys(kb.rudder_left)}  |  {keys(kb.rudder_right)}",
-        f"THROTTLE {keys(kb.throttle_up)}  |  {keys(kb.throttle_down)}",
-        f"CENTRE   {keys(kb.center)}  (surfaces return to the trim at {kb.centering:g}/s)",
-    ]
-    return lines
-
-
 @dataclass
 class SessionStats:
     saved: int = 0
@@ -111,73 +70,69 @@ class SessionStats:
 
 
 class ManualSession:
-    """Run the collection loop.
+    """Run the collection loop of one ``ManualConfig``.
 
     Args:
-        flight: what to fly (a solo flight spec).
-        out: session folder (``logs/``, ``dataset/``).
-        device: keyboard, mouse, joystick or flightgear (FlightGear's cockpit).
-        bindings: recipe tables ``{"keyboard": {...}, "mouse": {...}, "joystick": {...},
-            "flightgear": {...}}``.
-        assist: None, ``"controller"`` or a policy checkpoint path: it flies unless the human
-            takes over (T); the human's frames are flagged as interventions.
-        seed: seed of the first episode (a discarded episode is flown again with its seed).
-        max_episodes: stop after this many saved episodes (0 = until quit).
-        realtime: pace frames to the wall clock at the env's rate.
-        on_frame: called at the start of each frame (tests and the synthetic pilot inject
-            events with it). Without it a person flies: a session with no window they can
-            see, or no joystick for ``device="joystick"``, is refused at once
-            (``manual.devices``), never left waiting for input that cannot come.
-        views: FlightGear UDP ports showing the aircraft (out-the-window views).
-        source: what the dataset calls the pilot (default: human, or ASSIST+human).
-        draw: draw the window every frame (a headless synthetic pilot needs no pictures).
-        build_each: bring the dataset up to date after every saved episode (a person's
-            session, so that quitting loses nothing); else once, at the end (the log keeps
-            every episode durable either way).
-        images, image_size: camera views the dataset holds as video (``datasets.videos``).
-        pilot_view: the camera the window shows beside the instruments (``front``, ``chase``),
-            so a person can fly without FlightGear; ``None``: instruments only.
+        config: what to fly and how (``collectors.config.ManualConfig``): the flight, the
+            session folder, the device and its bindings, an assistant (``controller`` or a
+            policy that flies until the pilot takes over, T; the pilot's frames are flagged
+            as interventions), the seed of the first episode (a discarded episode is flown
+            again with its seed), the episodes to save (0: until quit), FlightGear views, the
+            dataset's camera views and the window's camera.
+        on_frame: called at the start of each frame with the frame's number and the session
+            (tests inject events with it). A synthetic pilot's session is driven by
+            ``collectors.synthetic.SyntheticDriver`` unless another hook is given. Without a
+            hook a person flies: a session with no window they can see, or no joystick for
+            ``device="joystick"``, is refused at once (``manual.devices``), never left
+            waiting for input that cannot come.
+        realtime: pace frames to the wall clock at the flight's rate (default: for a person;
+            the synthetic pilot flies as fast as the machine allows).
+        draw: draw the window every frame (default: for a person; the synthetic pilot needs
+            no pictures).
+
+    A person's session brings the dataset up to date after every saved episode (so that
+    quitting loses nothing); the synthetic pilot's once, at the end (the log keeps every
+    episode durable either way). The dataset calls the pilot ``human`` or ``synthetic``
+    (``controller+human`` and so on with an assistant).
     """
 
     def __init__(
         self,
-        flight: FlightSpec,
-        out: Path,
-        device: str = "keyboard",
-        bindings: dict[str, dict[str, Any]] | None = None,
-        assist: str | None = None,
-        seed: int = 0,
-        max_episodes: int = 0,
-        realtime: bool = True,
-        on_frame: Callable[[int, ManualSession], None] | None = None,
-        views: tuple[int, ...] = (),
-        source: str | None = None,
-        draw: bool = True,
-        build_each: bool = True,
-        images: Sequence[str] = (),
-        image_size: int = DEFAULT_IMAGE_SIZE,
-        pilot_view: str | None = "front",
+        config: ManualConfig,
+        on_frame: FrameHook | None = None,
+        *,
+        realtime: bool | None = None,
+        draw: bool | None = None,
     ) -> None:
-        if on_frame is None:  # a person at the controls
-            check_person_can_fly(device)
-        bindings, out = bindings or {}, Path(out)
+        synthetic = config.pilot == "synthetic"
+        if on_frame is None and synthetic:
+            from gymfg_il.collectors.synthetic import SyntheticDriver
+
+            on_frame = SyntheticDriver(config.skill)
+        elif on_frame is None:  # a person at the controls
+            check_person_can_fly(config.device)
+        out = config.out
         check_out_folder(out)
-        self.flight, self.out, self.seed, self.max_episodes = flight, out, seed, max_episodes
-        self.realtime, self.on_frame = realtime, on_frame
-        self.env = flight.make_env(list(views) or None)
-        self.images, self.image_size = list(images), image_size
-        check_appendable(out, self.env.observation_names, flight.agent_hz, None, images, image_size)
-        self.kb = from_table(KeyboardBindings, bindings.get("keyboard"), "[collector.keyboard]")
+        flight = self.flight = config.flight()
+        self.config, self.out, self.on_frame = config, out, on_frame
+        self.seed, self.max_episodes = config.seed, config.episodes
+        self.realtime = not synthetic if realtime is None else realtime
+        self.draw = not synthetic if draw is None else draw
+        self.build_each = not synthetic
+        self.env = flight.make_env(list(config.view) or None)
+        self.images, self.image_size = list(config.images), config.image_size
+        names = self.env.observation_names
+        check_appendable(out, names, flight.agent_hz, None, self.images, self.image_size)
+        self.kb = from_table(KeyboardBindings, config.keyboard, "[collector.keyboard]")
         self.human = ManualController(
-            device,
+            config.device,
             self.kb,
-            from_table(MouseBindings, bindings.get("mouse"), "[collector.mouse]"),
-            from_table(JoystickBindings, bindings.get("joystick"), "[collector.joystick]"),
+            from_table(MouseBindings, config.mouse, "[collector.mouse]"),
+            from_table(JoystickBindings, config.joystick, "[collector.joystick]"),
             throttle=self.env.aircraft.profile.cruise_throttle,
-            flightgear=from_table(
-                FlightGearBindings, bindings.get("flightgear"), "[collector.flightgear]"
-            ),
+            flightgear=from_table(FlightGearBindings, config.flightgear, "[collector.flightgear]"),
         )
+        assist = config.assist
         self.assist_name = (
             None if assist is None else ("controller" if assist == "controller" else "policy")
         )
@@ -191,19 +146,19 @@ class ManualSession:
             assistant = spec.make(self.env)
         self.pilot = Takeover(self.human, assistant)
         self.rollout = Rollout(self.env, [self.pilot])
-        person = source or "human"
+        person = "synthetic" if synthetic else "human"
         self.source = person if assist is None else f"{self.assist_name}+{person}"
-        self.draw, self.build_each = draw, build_each
-        self.help = help_lines(device, self.kb)
+        self.help = help_lines(config.device, self.kb)
         title = f"GymFG-IL: {flight.task_label} on {self.env.aircraft.model}"
-        self.camera = Camera(320, 320, view=pilot_view) if pilot_view and draw else None
+        pilot_view = None if config.pilot_view == "none" else config.pilot_view
+        self.camera = Camera(320, 320, view=pilot_view) if pilot_view and self.draw else None
         self.gui = ControlsGUI(size=(1250, 600) if self.camera else (900, 600), title=title)
         self.human.window_size = self.gui.size
         self.stats = SessionStats()
         self.state = "idle"
         self.show_help = True
         self.episode = 0
-        self.next_seed = seed  # a discarded episode is flown again with its seed
+        self.next_seed = config.seed  # a discarded episode is flown again with its seed
         self.last_action = np.array([0.0, 0.0, 0.0, self.env.aircraft.profile.cruise_throttle])
         self.message = "Space: start an episode"
         self.writer: TrajectoryWriter | None = None
@@ -287,46 +242,7 @@ class ManualSession:
             self._finish(step.reason or "terminated" if step.terminated else "time limit")
 
     def _draw(self) -> None:
-        env = self.env
-        slot = env.world.slots[0]
-        state = slot.state
-        names = env.observation_names
-        target = actual = None
-        target_name = ""
-        target_names = [n for n in names if n.endswith("_target")]
-        if target_names and self.state != "idle":
-            var = target_names[0].removesuffix("_target")
-            target_name = f"{var} ({BY_NAME[var].unit})"
-            target = env.task.target_value(env.world.steps)
-            actual = float(state[INDEX[var]])
-        left = (
-            max(0.0, (env.world.max_steps - env.world.steps) * env.dt)
-            if self.state != "idle"
-            else env.world.max_steps * env.dt
-        )
-        pilot = "human" if self.human_flies else str(self.assist_name)
-        frame = GuiFrame(
-            action=self.human.values
-            if self.human_flies or self.state == "idle"
-            else getattr(self, "last_action", self.human.values),
-            variables={n: (float(state[INDEX[n]]), BY_NAME[n].unit) for n in SHOWN},
-            target_name=target_name,
-            target=target,
-            actual=actual,
-            episode=self.episode,
-            time_left_s=left,
-            status=self.state,
-            pilot=pilot,
-            message=self.message or self.human.status,
-            help_lines=self.help,
-            show_help=self.show_help,
-            view=None
-            if self.camera is None
-            else self.camera.frame(
-                state, landmarks_of(env.task, getattr(env.task, "plan", None), env.world.steps)
-            ),
-        )
-        self.gui.draw(frame)
+        self.gui.draw(window_frame(self))
 
     def run(self, max_frames: int | None = None) -> SessionStats:
         import pygame

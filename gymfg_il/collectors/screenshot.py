@@ -22,8 +22,8 @@ def main(argv: list[str] | None = None) -> int:
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     import pygame
 
+    from gymfg_il.collectors.config import ManualConfig
     from gymfg_il.collectors.manual import ManualSession
-    from gymfg_il.envs.flight import FlightSpec
 
     def key(k: int, down: bool = True) -> None:
         kind = pygame.KEYDOWN if down else pygame.KEYUP
@@ -43,10 +43,15 @@ def main(argv: list[str] | None = None) -> int:
             key(pygame.K_q)
 
     with tempfile.TemporaryDirectory() as tmp:
-        spec = FlightSpec.solo("c172p", "altitude", episode_time_s=30, agent_hz=30)
-        ManualSession(
-            spec, Path(tmp), assist="controller", realtime=False, seed=3, on_frame=on_frame
-        ).run(max_frames=200)
+        cfg = ManualConfig(
+            task="altitude",
+            episode_time_s=30,
+            agent_hz=30,
+            seed=3,
+            out=Path(tmp),
+            assist="controller",  # it flies until the injected T
+        )
+        ManualSession(cfg, on_frame, realtime=False).run(max_frames=200)
     print(f"screenshot written to {target}")
     return 0
 

@@ -30,8 +30,14 @@ from gymfg_il.workers import Workers
 DATASET = "dataset"
 log = logging.getLogger(__name__)
 
-__all__ = ["DATASET", "LOGS", "SessionResult", "check_appendable", "check_out_folder",
-           "record_session"]  # fmt: skip
+__all__ = [
+    "DATASET",
+    "LOGS",
+    "SessionResult",
+    "check_appendable",
+    "check_out_folder",
+    "record_session",
+]
 
 
 def check_out_folder(out: Path) -> None:

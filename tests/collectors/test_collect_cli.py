@@ -11,6 +11,7 @@ import pytest
 
 from gymfg_il import collect
 from gymfg_il.collectors.config import CollectConfig
+from gymfg_il.envs import FlightSpec
 from gymfg_il.errors import ConfigError
 
 ENV = {**os.environ, "HF_HUB_OFFLINE": "1", "PYTHONUNBUFFERED": "1"}
@@ -125,8 +126,8 @@ def test_replay_into_a_view_sends_every_step_and_checks_every_state(tmp_path, ca
     import socket
 
     out = tmp_path / "session"
-    assert collect.main(["autopilot", "--out", str(out), "--episodes", "1", "--episode-time",
-                         "2", "--no-progress"]) == 0  # fmt: skip
+    argv = ["autopilot", "--out", str(out), "--episodes", "1", "--episode-time", "2"]
+    assert collect.main([*argv, "--no-progress"]) == 0
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as view:
         view.bind(("127.0.0.1", 0))
         port = view.getsockname()[1]
@@ -140,6 +141,26 @@ def test_replay_into_a_view_sends_every_step_and_checks_every_state(tmp_path, ca
                 break
     assert "ego: 20 steps, identical" in capsys.readouterr().out
     assert len(packets) == 21 and {len(p) for p in packets} == {408}  # the reset, then 20 steps
+
+
+def test_a_recipe_is_an_autopilot_or_a_manual_config(tmp_path):
+    from pathlib import Path
+
+    from gymfg_il.collectors.config import ManualConfig
+
+    recipes = Path(__file__).resolve().parents[2] / "collectors"
+    manual = CollectConfig.from_recipe(recipes / "manual-keyboard.toml")
+    assert isinstance(manual, ManualConfig) and manual.keyboard["rate"] == 1.5
+    assert manual.flight() == FlightSpec.solo("c172p", "altitude", agent_hz=30)
+    auto = CollectConfig.from_recipe(recipes / "sample.toml")
+    assert type(auto) is CollectConfig and auto.flight().task_kwargs["target_range"]
+    path = tmp_path / "r.toml"
+    path.write_text('[collector]\ntask = "roll"\ndevice = "mouse"\n')
+    with pytest.raises(ConfigError, match=r"unknown keys \['device'\] \(manual sessions only"):
+        CollectConfig.from_recipe(path)
+    path.write_text('[collector]\nkind = "human"\n')
+    with pytest.raises(ConfigError, match="kind='human': choose autopilot or manual"):
+        CollectConfig.from_recipe(path)
 
 
 def test_recipe_overrides_take_each_kind_its_own_flags(capsys):

@@ -9,13 +9,19 @@ import pytest
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 import pygame
 
+from gymfg_il.collectors.config import ManualConfig
 from gymfg_il.collectors.manual import ManualSession
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.data import load_frames
 from gymfg_il.manual.bindings import deflect, deflection
 
-SPEC = FlightSpec.solo("c172p", "altitude", episode_time_s=3, agent_hz=30)  # 90 frames an episode
+FLIGHT = {"task": "altitude", "episode_time_s": 3, "agent_hz": 30}  # 90 frames an episode
+
+
+def manual_config(out, **kwargs):
+    """A person's session (until they quit) of the altitude task, into ``out``."""
+    return ManualConfig(**{**FLIGHT, "episodes": 0, "out": out, **kwargs})
 
 
 def key(k, down=True):
@@ -33,8 +39,8 @@ def run(out, script, **kwargs):
         for event in script.get(frame, []):
             event() if callable(event) else pygame.event.post(event)
 
-    session = ManualSession(SPEC, out, realtime=False, on_frame=on_frame, **kwargs)
-    return session.run(max_frames=kwargs.pop("frames", 400))
+    session = ManualSession(manual_config(out, **kwargs), on_frame, realtime=False)
+    return session.run(max_frames=400)
 
 
 def test_keyboard_rates_and_centring_reach_the_dataset(tmp_path):
@@ -100,8 +106,7 @@ def test_joystick_axes_buttons_and_unplugging(tmp_path):
         60: [button_end],
         200: [lambda: key(pygame.K_q)],
     }
-    bindings = {"joystick": {"buttons": {2: "end"}}}
-    stats = run(tmp_path, script, device="joystick", bindings=bindings)
+    stats = run(tmp_path, script, device="joystick", joystick={"buttons": {2: "end"}})
     assert stats.saved == 1
     frames = load_frames(tmp_path / "dataset")
     a = frames.action
@@ -153,9 +158,8 @@ def test_discarded_episode_is_flown_again_with_its_seed(tmp_path):
 
 def test_appending_another_task_is_refused(tmp_path):
     run(tmp_path, {1: [lambda: key(pygame.K_SPACE)], 200: [lambda: key(pygame.K_q)]})
-    roll = FlightSpec.solo("c172p", "roll", episode_time_s=3, agent_hz=30)
     with pytest.raises(ConfigError, match="features differ"):
-        ManualSession(roll, tmp_path, realtime=False, on_frame=driven)
+        ManualSession(manual_config(tmp_path, task="roll"), driven, realtime=False)
 
 
 def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
@@ -172,7 +176,7 @@ def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
         if frame == 20:
             key(pygame.K_q)
 
-    ManualSession(SPEC, tmp_path, realtime=False, on_frame=on_frame).run(max_frames=40)
+    ManualSession(manual_config(tmp_path), on_frame, realtime=False).run(max_frames=40)
     flying = [f for f in drawn if f.status != "idle"]
     assert flying and all(f.target_name == "altitude_ft (ft)" for f in flying)
     assert all(abs(f.target - f.actual) <= 1000 for f in flying)
@@ -191,7 +195,7 @@ def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
         if frame == 30:
             key(pygame.K_q)
 
-    session = ManualSession(SPEC, tmp_path, realtime=False, on_frame=on_frame)
+    session = ManualSession(manual_config(tmp_path), on_frame, realtime=False)
     assert session.gui.size == (1250, 600) and session.camera is not None
     session.run(max_frames=40)
     # the view's box right of the instruments: sky on top (blue), ground below (green)
@@ -200,7 +204,9 @@ def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
         assert (view[20:60, :, 2] > view[20:60, :, 1]).mean() > 0.9
     # after rolling, the view changed
     assert np.abs(shots[2][100:420, 910:1230].astype(int) - shots[25][100:420, 910:1230]).mean() > 3
-    headless = ManualSession(SPEC, tmp_path / "b", realtime=False, pilot_view=None, on_frame=driven)
+    headless = ManualSession(
+        manual_config(tmp_path / "b", pilot_view="none"), driven, realtime=False
+    )
     assert headless.gui.size == (900, 600) and headless.camera is None
 
 
@@ -215,16 +221,15 @@ def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
     config = {"type": "mlp", "policy": {}, "obs_stats": stats, "action_stats": stats}
     (policy / "config.json").write_text(json.dumps({**config, "spec": spec.to_dict(), "fps": 10}))
     with pytest.raises(ConfigError, match=r"trained at 10 Hz.*at 30 Hz"):
-        ManualSession(SPEC, tmp_path / "out", assist=str(policy), realtime=False, on_frame=driven)
+        ManualSession(manual_config(tmp_path / "out", assist=str(policy)), driven, realtime=False)
 
 
 def test_the_dataset_helper_builds_on_request_and_outlives_a_crash(tmp_path, caplog):
     from gymfg_il import collect
     from gymfg_il.collectors.updater import DatasetUpdater
 
-    argv = ["autopilot", "--episodes", "2", "--episode-time", "2", "--out", str(tmp_path),
-            "--no-progress"]  # fmt: skip
-    assert collect.main(argv) == 0
+    argv = ["autopilot", "--episodes", "2", "--episode-time", "2", "--out", str(tmp_path)]
+    assert collect.main([*argv, "--no-progress"]) == 0
     shutil.rmtree(tmp_path / "dataset")
     updater = DatasetUpdater(tmp_path)
     updater.warm()

@@ -11,23 +11,20 @@ import pytest
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 
 from gymfg_il import collect
+from gymfg_il.collectors.config import ManualConfig
 from gymfg_il.collectors.manual import ManualSession
 from gymfg_il.collectors.synthetic import SyntheticDriver
-from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.learning.data import load_frames
 from gymfg_il.manual.controller import ManualController
 from gymfg_il.manual.synthetic import Skill
 
-FLIGHT = FlightSpec.solo("c172p", "altitude", episode_time_s=8, agent_hz=30)
-
 
 def fly(tmp_path, device, skill=0.5):
+    flight = {"task": "altitude", "episode_time_s": 8, "agent_hz": 30}
+    pilot = {"pilot": "synthetic", "device": device}
+    cfg = ManualConfig(**flight, **pilot, episodes=1, seed=11, out=tmp_path)
     driver = SyntheticDriver(skill)
-    session = ManualSession(
-        FLIGHT, tmp_path, device, realtime=False, on_frame=driver, source="synthetic",
-        draw=False, build_each=False, max_episodes=1, seed=11,
-    )  # fmt: skip
-    session.run()
+    ManualSession(cfg, driver).run()
     return driver, load_frames(tmp_path / "dataset")
 
 
@@ -61,8 +58,9 @@ def test_a_novice_is_late_and_lapses_an_ace_less_so():
 
 
 def test_collect_manual_with_the_synthetic_pilot_runs_headless(tmp_path, capsys):
-    argv = ["manual", "--pilot", "synthetic", "--device", "keyboard", "--task", "roll",
-            "--episodes", "2", "--episode-time", "5", "--out", str(tmp_path)]  # fmt: skip
+    flight = ["--task", "roll", "--episode-time", "5"]
+    pilot = ["--pilot", "synthetic", "--device", "keyboard"]
+    argv = ["manual", *pilot, *flight, "--episodes", "2", "--out", str(tmp_path)]
     assert collect.main(argv) == 0
     out, err = capsys.readouterr()
     assert "saved 2 episode(s)" in out and "2/2" in err  # the progress bar reached the end
@@ -74,10 +72,10 @@ def test_collect_manual_with_the_synthetic_pilot_runs_headless(tmp_path, capsys)
 def test_eval_scores_the_synthetic_pilot_beside_the_controller(tmp_path):
     from gymfg_il import eval as evaluate
 
-    argv = ["--pilot", "synthetic", "--device", "keyboard", "--task", "altitude",
-            "--episodes", "2", "--episode-time", "40", "--no-progress",
-            "--json", str(tmp_path / "rows.json")]  # fmt: skip
-    assert evaluate.main(argv) == 0
+    flight = ["--task", "altitude", "--episode-time", "40"]
+    pilot = ["--pilot", "synthetic", "--device", "keyboard"]
+    argv = [*pilot, *flight, "--episodes", "2", "--json", str(tmp_path / "rows.json")]
+    assert evaluate.main([*argv, "--no-progress"]) == 0
     rows = json.loads((tmp_path / "rows.json").read_text())["rows"]
     controller, pilot = rows
     assert controller["agent"] == "controller" and "synthetic" in pilot["agent"]

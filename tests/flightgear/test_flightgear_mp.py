@@ -247,8 +247,8 @@ def test_a_manual_session_records_what_flightgear_commands(sky, tmp_path):
     """Keys and FlightGear's stick follow what the session has heard, not fixed frames: a
     busy machine's FlightGear sends a packet every 0.2-0.4 s, and the session starting an
     episode (its dataset helper's imports) can stall it for longer."""
+    from gymfg_il.collectors.config import ManualConfig
     from gymfg_il.collectors.manual import ManualSession
-    from gymfg_il.envs.flight import FlightSpec
     from gymfg_il.learning.data import load_frames
 
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
@@ -279,16 +279,18 @@ def test_a_manual_session_records_what_flightgear_commands(sky, tmp_path):
             key(pygame.K_q)
 
     sky.set("/controls/flight/rudder", -0.2)
-    spec = FlightSpec.solo("c172p", "altitude", episode_time_s=120, agent_hz=30)
-    session = ManualSession(
-        spec,
-        tmp_path,
+    cfg = ManualConfig(
+        task="altitude",
+        episode_time_s=120,
+        agent_hz=30,
+        episodes=0,
+        seed=0,
+        out=tmp_path,
         device="flightgear",
-        bindings={"flightgear": {"port": sky.ctrls}},
-        on_frame=on_frame,
-        draw=False,
-        pilot_view=None,
+        flightgear={"port": sky.ctrls},
+        pilot_view="none",
     )
+    session = ManualSession(cfg, on_frame, draw=False)
     stats = session.run(max_frames=30 * 110)  # the deadline: quit comes long before
     sky.set("/controls/flight/rudder", 0.0)
     print(f"manual session: {at} (frames)")

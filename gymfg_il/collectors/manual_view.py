@@ -1,0 +1,63 @@
+"""What the manual session's window shows each frame: the instruments (``SHOWN``), the
+tracked variable against its target, the stick, the session's state and, beside them, the
+pilot's camera."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from gymfg_il.manual.gui import GuiFrame
+from gymfg_il.sim.properties import BY_NAME, INDEX
+from gymfg_il.tasks.scenery import landmarks_of
+
+if TYPE_CHECKING:
+    from gymfg_il.collectors.manual import ManualSession
+
+SHOWN = (
+    "altitude_ft",
+    "airspeed_kts",
+    "vertical_speed_fps",
+    "heading_deg",
+    "roll_deg",
+    "pitch_deg",
+    "alpha_deg",
+    "beta_deg",
+    "thrust_lbs",
+)
+
+
+def window_frame(session: ManualSession) -> GuiFrame:
+    """The window's frame of the session as it is now."""
+    env = session.env
+    world = env.world
+    state = world.slots[0].state
+    flying = session.state != "idle"
+    target = actual = None
+    target_name = ""
+    targets = [n for n in env.observation_names if n.endswith("_target")]
+    if targets and flying:
+        var = targets[0].removesuffix("_target")
+        target_name = f"{var} ({BY_NAME[var].unit})"
+        target = env.task.target_value(world.steps)
+        actual = float(state[INDEX[var]])
+    steps_left = world.max_steps - world.steps if flying else world.max_steps
+    human = session.human_flies or not flying
+    view = None
+    if session.camera is not None:
+        marks = landmarks_of(env.task, getattr(env.task, "plan", None), world.steps)
+        view = session.camera.frame(state, marks)
+    return GuiFrame(
+        action=session.human.values if human else session.last_action,
+        variables={n: (float(state[INDEX[n]]), BY_NAME[n].unit) for n in SHOWN},
+        target_name=target_name,
+        target=target,
+        actual=actual,
+        episode=session.episode,
+        time_left_s=max(0.0, steps_left * env.dt),
+        status=session.state,
+        pilot="human" if session.human_flies else str(session.assist_name),
+        message=session.message or session.human.status,
+        help_lines=session.help,
+        show_help=session.show_help,
+        view=view,
+    )
