@@ -9,26 +9,37 @@ vs controlled variable, reward).
 
 from __future__ import annotations
 
+import argparse
 import sys
 from collections.abc import Callable
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    from gymfg_il import cli
+    from gymfg_il.envs.options import TASK_OWN_TIME, unset_values
+    from gymfg_il.evaluation.config import EvalConfig
+
+    p = cli.parser("python -m gymfg_il.eval", __doc__)
+    unset = {**unset_values(), "episode_time_s": TASK_OWN_TIME}
+    cli.add_fields(p, EvalConfig, shown={k: f"the policy's, else {v}" for k, v in unset.items()})
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return p.parse_args(argv)
 
 
 def main(argv: list[str] | None = None) -> int:
     from gymfg_il import cli
     from gymfg_il.evaluation.config import EvalConfig
 
-    p = cli.parser("python -m gymfg_il.eval", __doc__)
-    cli.add_fields(p, EvalConfig)
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    args = p.parse_args(argv)
+    args = parse_args(argv)
     return cli.run(lambda: _main(cli.build(EvalConfig, args), not args.no_progress))
 
 
 def _main(cfg: object, show_progress: bool) -> int:
     from gymfg_il import cli
     from gymfg_il.datasets.lerobot_api import hub_offline
-    from gymfg_il.evaluation.config import EvalConfig, run_eval
+    from gymfg_il.evaluation.config import EvalConfig
     from gymfg_il.evaluation.report import ratio_line, table
+    from gymfg_il.evaluation.runner import run_eval
 
     assert isinstance(cfg, EvalConfig)
     hub_offline()
@@ -55,6 +66,11 @@ def _main(cfg: object, show_progress: bool) -> int:
     print(table(run.rows))
     for row in run.rows[1:]:
         print(f"\n{ratio_line(row)}")
+    pilots = [r for r in run.rows if str(r["agent"]).startswith("pilot:")]
+    for pilot in pilots:  # each policy beside the pilot it was scored against, too
+        for row in run.rows:
+            if str(row["agent"]).startswith("policy:"):
+                print(ratio_line(row, pilot))
     for path in run.written:
         print(f"{'rows' if path.suffix == '.json' else 'plot'} written to {path}")
     return 0

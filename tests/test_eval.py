@@ -83,7 +83,8 @@ def test_help_explains_every_option():
 def test_a_policy_flies_at_its_own_rate_and_the_rows_say_so(tmp_path, capsys):
     from gymfg_il.collectors.autopilot import collect_autopilot
     from gymfg_il.collectors.config import CollectConfig
-    from gymfg_il.evaluation.config import EvalConfig, run_eval
+    from gymfg_il.evaluation.config import EvalConfig
+    from gymfg_il.evaluation.runner import run_eval
     from gymfg_il.learning.bc import TrainConfig, train_bc
 
     demo = CollectConfig(
@@ -112,22 +113,28 @@ def test_a_policy_flies_at_its_own_rate_and_the_rows_say_so(tmp_path, capsys):
     assert evaluate.main([*args, "--aircraft", "f15", "--json", str(rows_json)]) == 0
     assert "aircraft='f15'" in capsys.readouterr().err
     assert {r["aircraft"] for r in json.loads(rows_json.read_text())["rows"]} == {"f15"}
+    # beside the synthetic pilot it is set against the pilot too, not only the controller
+    assert evaluate.main([*args, "--pilot", "synthetic"]) == 0
+    out = capsys.readouterr().out
+    assert "policy:p / controller: return" in out
+    assert "policy:p / pilot:synthetic-keyboard: return" in out
 
 
 def test_a_policy_without_a_single_flight_still_flies_at_its_datasets_rate():
     from pathlib import Path
 
+    from gymfg_il.envs.options import FlightOptions
     from gymfg_il.errors import ConfigError
+    from gymfg_il.evaluation.plan import flight_for
     from gymfg_il.evaluation.plots import primary_control
-    from gymfg_il.evaluation.runner import flight_for
 
     meta = {"spec": None, "fps": 30, "spec_note": "its episodes were flown in 2 flights"}
     with pytest.raises(ConfigError, match=r"2 flights.*--task and --aircraft"):
         flight_for({Path("p"): meta})
-    flight, _ = flight_for({Path("p"): meta}, task="roll", aircraft="f15")
+    flight, _ = flight_for({Path("p"): meta}, FlightOptions(task="roll", aircraft="f15"))
     assert (flight.agent_hz, flight.task, flight.aircraft) == (30, "roll", "f15")
     with pytest.raises(ConfigError, match=r"trained at \[30\] Hz"):
-        flight_for({Path("p"): meta}, task="roll", aircraft="f15", agent_hz=10)
+        flight_for({Path("p"): meta}, FlightOptions(task="roll", aircraft="f15", agent_hz=10))
     assert primary_control("beta_deg") == 2 and primary_control("my_own_variable") == 1
 
 

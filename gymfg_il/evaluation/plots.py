@@ -7,8 +7,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from gymfg_il.evaluation.trace import Trace
-from gymfg_il.sim.properties import ACTION_NAMES
+from gymfg_il.sim.properties import ACTION_NAMES, BY_NAME
 
 # The surface that mainly drives each controlled variable (Figure 1's "control signal").
 PRIMARY_CONTROL = {
@@ -26,13 +28,22 @@ def primary_control(variable: str) -> int:
     return PRIMARY_CONTROL.get(variable, 1)
 
 
-UNITS = {
-    "altitude_ft": "ft",
-    "roll_deg": "deg",
-    "pitch_deg": "deg",
-    "heading_deg": "deg",
-    "airspeed_kts": "kt",
-}
+def drawn(trace: Trace) -> tuple[np.ndarray, np.ndarray]:
+    """(target, value) of ``trace`` as a plot draws them: an angle that goes all the way
+    round (heading, roll) is unwrapped, so that crossing north is not a jump of 360 degrees
+    and the same target is never drawn once at -100 and once at 260; the target is drawn on
+    the value's turn (value + error, the error being wrapped to [-180, 180))."""
+    var = BY_NAME.get(trace.variable)
+    if var is None or var.unit != "deg" or var.high - var.low < 360.0:
+        return trace.target, trace.value
+    value = np.unwrap(trace.value, period=360.0)
+    return np.unwrap(value + trace.error, period=360.0), value
+
+
+def unit_of(variable: str) -> str:
+    """The catalogue's unit of ``variable`` ("" for one it does not hold)."""
+    var = BY_NAME.get(variable)
+    return var.unit if var is not None else ""
 
 
 def figure1(episodes: Sequence[Trace], control: int, title: str, path: Path) -> Path:
@@ -49,9 +60,10 @@ def figure1(episodes: Sequence[Trace], control: int, title: str, path: Path) -> 
         var = ep.variable
         row[0].plot(t, ep.actions[:, control], color="tab:blue", lw=1)
         row[0].set_ylabel(f"seed {ep.seed}\n{ACTION_NAMES[control]}")
-        row[1].plot(t, ep.target, color="tab:red", lw=1.2, ls="--", label="target")
-        row[1].plot(t, ep.value, color="tab:green", lw=1, label=var)
-        row[1].set_ylabel(f"{var.rsplit('_', 1)[0]} ({UNITS.get(var, '')})")
+        target, value = drawn(ep)
+        row[1].plot(t, target, color="tab:red", lw=1.2, ls="--", label="target")
+        row[1].plot(t, value, color="tab:green", lw=1, label=var)
+        row[1].set_ylabel(f"{var.rsplit('_', 1)[0]} ({unit_of(var)})")
         row[2].plot(t, ep.rewards, color="tab:purple", lw=1)
         row[2].set_ylabel("reward")
         if ep.terminated:

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 COLUMNS = (
     ("agent", "agent", "{}"),
@@ -36,15 +37,28 @@ def table(rows: Sequence[dict[str, object]]) -> str:
     return "\n".join(lines)
 
 
-def _share(value: object, what: str) -> str:
-    if value is None:
-        return f"{what} n/a (the controller's is 0)"
-    return f"{what} {float(value):.1%}"  # type: ignore[arg-type]
+# (score, its share's key in a row, its name in words)
+SHARES = (("mean_return", "return_ratio", "return"), ("success_rate", "success_ratio", "success"))
 
 
-def ratio_line(row: dict[str, object]) -> str:
-    """``policy:P / controller: return 99.7%, success 100.0%`` for one row."""
-    return (
-        f"{row['agent']} / controller: {_share(row['return_ratio'], 'return')}, "
-        f"{_share(row['success_ratio'], 'success')}"
-    )
+def shares(row: Mapping[str, Any], reference: Mapping[str, Any]) -> dict[str, float | None]:
+    """The mean return and success rate of ``row`` as shares of ``reference``'s, by the keys
+    ``return_ratio`` and ``success_ratio``; None where the reference's is zero."""
+    found: dict[str, float | None] = {}
+    for key, ratio, _ in SHARES:
+        ref, value = float(reference[key]), float(row[key])
+        found[ratio] = value / ref if ref else None
+    return found
+
+
+def ratio_line(row: Mapping[str, Any], reference: Mapping[str, Any] | None = None) -> str:
+    """``policy:P / controller: return 99.7%, success 100.0%``: a row's shares of the
+    controller's scores (the row's own ratios), or of another ``reference`` row's."""
+    against = "controller" if reference is None else str(reference["agent"])
+    values = row if reference is None else shares(row, reference)
+    parts = []
+    for _, ratio, what in SHARES:
+        value = values[ratio]
+        shown = f"n/a (the {against}'s is 0)" if value is None else f"{float(value):.1%}"
+        parts.append(f"{what} {shown}")
+    return f"{row['agent']} / {against}: {', '.join(parts)}"

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.evaluation.plots import save_figure
+from gymfg_il.evaluation.plots import drawn, save_figure
 from gymfg_il.evaluation.trace import Trace
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.maneuvers import local_ft
@@ -88,7 +88,8 @@ def ground_tracks(
             else:
                 side.plot(np.arange(len(alt)) * tr.dt, alt, color=colour, lw=1)
         if not approach:  # the altitude each step aimed for (the next gate's, ...)
-            side.plot(first.time_s, first.target, color="tab:red", ls="--", lw=1, label="target")
+            target, _ = drawn(first)
+            side.plot(first.time_s, target, color="tab:red", ls="--", lw=1, label="target")
         _draw_plan(top, side, plan, origin)
         top.set_aspect("equal", adjustable="datalim")
         top.set_ylabel(f"seed {first.seed}\nnorth (ft)")

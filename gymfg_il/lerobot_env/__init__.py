@@ -22,14 +22,16 @@ from lerobot.configs import FeatureType, PolicyFeature
 from lerobot.envs.configs import EnvConfig
 from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_IMAGES, OBS_STATE
 
+from gymfg_il.envs.options import FlightOptions
 from gymfg_il.errors import ConfigError, join_problems
-from gymfg_il.evaluation.config import TASKS
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ
+from gymfg_il.sim.weather import TURBULENCE, Turbulence
+from gymfg_il.tasks.library import TRACKED_TASKS
 
 NAMESPACE = "gym_gymfg"
 ENTRY_POINT = "gymfg_il.lerobot_env.env:LeRobotFlightEnv"
 
-for _task in TASKS:
+for _task in TRACKED_TASKS:
     if f"{NAMESPACE}/{_task}" not in gym.registry:
         gym.register(f"{NAMESPACE}/{_task}", entry_point=ENTRY_POINT, kwargs={"task": _task})
 
@@ -37,7 +39,9 @@ for _task in TASKS:
 @EnvConfig.register_subclass("gymfg")
 @dataclass
 class GymFGEnv(EnvConfig):
-    """A GymFG solo flight for LeRobot's tools.
+    """A GymFG solo flight for LeRobot's tools: the flight options
+    (``envs.options.FlightOptions``) under LeRobot's names (its ``fps`` is our ``agent_hz``),
+    and the camera views the policy is given.
 
     Attributes:
         task: our task name: altitude, roll, pitch, heading, airspeed, sideslip, level, or a
@@ -58,16 +62,16 @@ class GymFGEnv(EnvConfig):
     fps: int = DEFAULT_AGENT_HZ
     images: list[str] = field(default_factory=list)
     image_size: int = 128
-    turbulence: str = "none"
+    turbulence: Turbulence = "none"
     features: dict[str, PolicyFeature] = field(default_factory=dict)
     features_map: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         problems = []
-        if self.task not in TASKS:
-            problems.append(f"task={self.task!r}: choose one of {', '.join(TASKS)}")
-        if self.turbulence not in ("none", "light", "moderate", "severe"):
-            problems.append(f"turbulence={self.turbulence!r}: none, light, moderate or severe")
+        if self.task not in TRACKED_TASKS:
+            problems.append(f"task={self.task!r}: choose one of {', '.join(TRACKED_TASKS)}")
+        if self.turbulence not in TURBULENCE:
+            problems.append(f"turbulence={self.turbulence!r}: {', '.join(TURBULENCE)}")
         if problems:
             raise ConfigError(join_problems("--env (gymfg)", problems))
         env = self.make_one()
@@ -99,17 +103,22 @@ class GymFGEnv(EnvConfig):
     def gym_id(self) -> str:
         return f"{NAMESPACE}/{self.task}"
 
+    def flight_options(self) -> FlightOptions:
+        """The flight these fields describe."""
+        return FlightOptions(
+            aircraft=self.aircraft,
+            task=self.task,
+            dynamic=self.dynamic,
+            episode_time_s=self.episode_time_s,
+            agent_hz=self.fps,
+            turbulence=self.turbulence,
+        )
+
     @property
     def gym_kwargs(self) -> dict[str, Any]:
-        return {
-            "aircraft": self.aircraft,
-            "dynamic": self.dynamic,
-            "episode_time_s": self.episode_time_s,
-            "agent_hz": self.fps,
-            "images": list(self.images),
-            "image_size": self.image_size,
-            "turbulence": self.turbulence,
-        }
+        options = self.flight_options().given()
+        del options["task"]  # the gym id names it
+        return {**options, "images": list(self.images), "image_size": self.image_size}
 
     def make_one(self) -> Any:
         """One env of this config (what ``create_envs`` vectorises)."""

@@ -25,7 +25,7 @@ import gymnasium as gym
 import numpy as np
 
 from gymfg_il.datasets.videos import check_views
-from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.options import FlightOptions, options_problem
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.evaluation.metrics import score_episode
 from gymfg_il.evaluation.trace import make_trace
@@ -41,13 +41,11 @@ class LeRobotFlightEnv(gym.Env):
 
     Args:
         task: our task name (roll, altitude, turn, approach, ...).
-        aircraft: JSBSim model.
-        dynamic: moving targets.
-        episode_time_s: episode length (None: the task's own).
-        agent_hz: agent rate (the dataset's fps).
         images: camera views given as ``pixels`` (``front``, ``chase``).
         image_size: their square size in pixels.
-        turbulence: none, light, moderate or severe.
+        options: the other flight options (``envs.options.FlightOptions``: ``aircraft``,
+            ``dynamic``, ``episode_time_s``, ``agent_hz``, the dataset's fps,
+            ``turbulence``, ...).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": DEFAULT_AGENT_HZ}  # noqa: RUF012
@@ -55,27 +53,20 @@ class LeRobotFlightEnv(gym.Env):
     def __init__(
         self,
         task: str = "roll",
-        aircraft: str = "c172p",
-        dynamic: bool = False,
-        episode_time_s: float | None = None,
-        agent_hz: int = DEFAULT_AGENT_HZ,
+        *,
         images: Sequence[str] = (),
         image_size: int = 128,
-        turbulence: str = "none",
         render_mode: str = "rgb_array",
+        **options: Any,
     ) -> None:
-        flight = FlightSpec.solo(
-            aircraft,
-            task,
-            dynamic=dynamic,
-            agent_hz=agent_hz,
-            episode_time_s=episode_time_s,
-            turbulence=turbulence,  # type: ignore[arg-type]
-        )
+        problem = options_problem(options)
+        if problem is not None:
+            raise problem
+        flight = FlightOptions(task=task, **options).flight()
         self.flight = flight
         self.env = AircraftEnv.from_flight(flight, render_mode="rgb_array", camera="chase")
         self.render_mode = render_mode
-        self.metadata = {**type(self).metadata, "render_fps": agent_hz}
+        self.metadata = {**type(self).metadata, "render_fps": flight.agent_hz}
         names = self.env.observation_names
         self._environment = task_columns(names)
         self.images = tuple(check_views(list(images)))
@@ -94,8 +85,8 @@ class LeRobotFlightEnv(gym.Env):
             )
         self.observation_space = gym.spaces.Dict(spaces)
         self.action_space = self.env.action_space
-        self._max_episode_steps = episode_steps(flight.episode_time_s, agent_hz)
-        self.task = task_description(self.env.task, aircraft)
+        self._max_episode_steps = episode_steps(flight.episode_time_s, flight.agent_hz)
+        self.task = task_description(self.env.task, flight.aircraft)
         self.task_description = self.task
         self._seed = -1
         self._steps: dict[str, list[Any]] = {}

@@ -62,7 +62,8 @@ def test_the_weather_is_part_of_the_flight_spec():
 
 
 def test_controllers_hold_their_targets_in_moderate_turbulence():
-    from gymfg_il.evaluation.config import EvalConfig, run_eval
+    from gymfg_il.evaluation.config import EvalConfig
+    from gymfg_il.evaluation.runner import run_eval
 
     for task in ("altitude", "roll"):
         run = run_eval(EvalConfig(task=task, episodes=4, turbulence="moderate", workers=2))
@@ -75,10 +76,9 @@ def test_demonstrations_can_be_collected_in_turbulence_and_keep_it_in_their_spec
     from gymfg_il import collect
     from gymfg_il.learning.data import load_frames
 
-    argv = ["autopilot", "--task", "roll", "--episodes", "1", "--episode-time", "3",
-            "--turbulence", "light", "--wind-kt", "5", "--out", str(tmp_path),
-            "--no-progress"]  # fmt: skip
-    assert collect.main(argv) == 0
+    weather = ["--turbulence", "light", "--wind-kt", "5"]
+    argv = ["autopilot", "--task", "roll", "--episodes", "1", "--episode-time", "3", *weather]
+    assert collect.main([*argv, "--out", str(tmp_path), "--no-progress"]) == 0
     flight, why = load_frames(tmp_path / "dataset").flight()
     assert flight is not None, why
     assert flight.weather.turbulence == "light" and flight.weather.wind_kt == 5.0

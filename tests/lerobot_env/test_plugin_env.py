@@ -69,3 +69,18 @@ def test_success_agrees_with_eval_and_render_is_rgb(plugin):
             break
     assert info["is_success"] is False
     env.close()
+
+
+def test_the_config_is_the_flight_options_under_lerobots_names(plugin):
+    from gymfg_il.envs import FlightSpec
+
+    cfg = plugin.GymFGEnv(task="heading", fps=30, episode_time_s=20.0, turbulence="light")
+    spec = FlightSpec.solo(task="heading", agent_hz=30, episode_time_s=20, turbulence="light")
+    assert cfg.flight_options().flight() == spec
+    env = cfg.make_one()
+    try:
+        assert env.flight == spec and env.metadata["render_fps"] == 30
+    finally:
+        env.close()
+    with pytest.raises(ConfigError, match="turbulence='gusty'"):
+        plugin.GymFGEnv(turbulence="gusty")
