@@ -191,13 +191,12 @@ def test_a_record_may_not_make_gymfg_import_the_task_it_names(tmp_path, monkeypa
 
     marker = tmp_path / "ran"
     (tmp_path / "evil_task_module.py").write_text(
-        f"open({str(marker)!r}, 'w').write('ran')\n"
-        "from gymfg_il.tasks import DummyTask as Task\n"
+        f"open({str(marker)!r}, 'w').write('ran')\nfrom gymfg_il.tasks import DummyTask as Task\n"
     )
     monkeypatch.syspath_prepend(str(tmp_path))
     record = FlightSpec.solo("c172p", "altitude").to_dict()
     record["teams"][0]["roster"][0]["task"] = "evil_task_module:Task"
-    with pytest.raises(UntrustedTaskError, match="evil_task_module.*not imported"):
+    with pytest.raises(UntrustedTaskError, match=r"evil_task_module.*not imported"):
         FlightSpec.from_dict(record)
     assert not marker.exists()
     # the user's trust, given by name, lets it be built
