@@ -146,11 +146,17 @@ def test_a_dataset_whose_episodes_differ_only_in_length_keeps_its_flight():
 
     short, long = (FlightSpec.solo(task="roll", episode_time_s=t) for t in (20, 60))
     frames = Frames(
-        obs=np.zeros((2, 1), np.float32), action=np.zeros((2, 4), np.float32),
-        episode=np.arange(2), frame=np.zeros(2, np.int64), observation_names=["x"],
-        action_names=list("abcd"), fps=10, obs_stats={}, action_stats={},
+        obs=np.zeros((2, 1), np.float32),
+        action=np.zeros((2, 4), np.float32),
+        episode=np.arange(2),
+        frame=np.zeros(2, np.int64),
+        observation_names=["x"],
+        action_names=list("abcd"),
+        fps=10,
+        obs_stats={},
+        action_stats={},
         episodes={"gymfg/spec": [short.to_json(), long.to_json()], "gymfg/callsign": ["ego"] * 2},
-    )  # fmt: skip
+    )
     assert frames.flight() == (long, "")
     frames.episodes["gymfg/spec"][0] = FlightSpec.solo(task="roll", agent_hz=20).to_json()
     flight, why = frames.flight()

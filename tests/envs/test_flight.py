@@ -16,10 +16,8 @@ from gymfg_il.tasks import DummyTask, ReachStaticTargetAltitudeTask, ReachStatic
 
 
 def test_a_solo_spec_round_trips_and_builds_its_env():
-    spec = FlightSpec.solo(
-        "a320", "heading", dynamic=True, task_kwargs={"hold_s": 12.5}, agent_hz=30,
-        episode_time_s=20,
-    )  # fmt: skip
+    options = {"dynamic": True, "task_kwargs": {"hold_s": 12.5}, "agent_hz": 30}
+    spec = FlightSpec.solo("a320", "heading", episode_time_s=20, **options)
     assert spec.aircraft == "A320" and spec.task_label == "heading-dynamic"
     assert FlightSpec.from_dict(spec.to_dict()) == spec
     assert FlightSpec.from_json(spec.to_json()) == spec
@@ -105,9 +103,12 @@ def test_the_spec_of_a_team_world_rebuilds_that_world():
     spec = FlightSpec.of_world(env.world)
     assert spec.rebuild_problems() == []
     assert spec.scenario == {
-        "name": "formation", "lead": asdict(_LEAD), "spacing_ft": 500.0, "jitter_ft": 0.0,
+        "name": "formation",
+        "lead": asdict(_LEAD),
+        "spacing_ft": 500.0,
+        "jitter_ft": 0.0,
         "heading_jitter_deg": 0.0,
-    }  # fmt: skip
+    }
     again = FlightSpec.from_json(spec.to_json())
     assert again == spec and again.episode_time_s == 10
     world = again.make_world()
