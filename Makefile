@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench pictures clean
 
 $(STAMP): pyproject.toml
 	$(PY) -c 'import sys; assert sys.version_info >= (3, 12), "GymFG-IL needs Python >= 3.12 (lerobot 0.6); install it or set PY=python3.12"'
@@ -26,6 +26,10 @@ lint: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python -m benchmarks.run
+
+# the README's and the docs' generated pictures, remade into docs/images/ from the current code
+pictures: $(STAMP)
+	PATH="$(CURDIR)/$(BIN):$$PATH" bash docs/experiments/pictures.sh
 
 clean:
 	rm -rf $(VENV) build *.egg-info
