@@ -121,7 +121,8 @@ def train_pipeline(dataset: Path, stock_items: int) -> Row:
     import torch
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    from gymfg_il.learning.data import TensorBatches, load_frames
+    from gymfg_il.learning.batches import TensorBatches
+    from gymfg_il.learning.data import load_frames
 
     frames = load_frames(dataset)
     batches = TensorBatches(frames, 256, seed=0)

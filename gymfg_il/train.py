@@ -7,47 +7,83 @@ config.json, so ``eval --policy`` and ``collect dagger --policy`` fly it as it w
 
 from __future__ import annotations
 
+import argparse
+import dataclasses
 import sys
+import typing
+from typing import Any
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The command line: ``bc`` takes ``TrainConfig``'s flags, ``--policy`` (the type) and
+    the settings of every registered policy type (``policy_settings``)."""
     from gymfg_il import cli
-    from gymfg_il.learning.bc import TrainConfig
+    from gymfg_il.learning.config import TrainConfig
+    from gymfg_il.policies.factory import policy_types
 
     p = cli.parser("python -m gymfg_il.train", __doc__)
     sub = p.add_subparsers(dest="algorithm", metavar="{bc}")
     bc = sub.add_parser(
         "bc",
-        help="behaviour cloning (MLP or GRU) on a LeRobot dataset",
+        help="behaviour cloning (MLP, GRU, action chunks or vision) on a LeRobot dataset",
         description="Train a behaviour-cloning policy on a LeRobot dataset; "
         "saves config.json, model.safetensors and loss.png.",
     )
-    cli.add_fields(bc, TrainConfig)
+    cli.add_fields(bc, TrainConfig, only=("dataset", "out"))
+    types = policy_types()
+    listed = "; ".join(f"{name}: {_first_sentence(t.config)}" for name, t in types.items())
+    bc.add_argument(
+        "--policy",
+        choices=list(types),
+        default="mlp",
+        help=f"policy type (default: mlp); {listed}".replace("%", "%%"),
+    )
+    cli.add_fields(bc, TrainConfig, skip=("dataset", "out"))
+    cli.add_fields(bc, policy_settings(), overrides_only=True)
     bc.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    from gymfg_il import cli
+
+    p = build_parser()
     args = p.parse_args(list(sys.argv[1:] if argv is None else argv))
     if args.algorithm is None:
         p.print_help()
         return 2
-    return cli.run(lambda: _bc(cli.build(TrainConfig, args), not args.no_progress))
+    return cli.run(lambda: _bc(args))
 
 
-def _bc(cfg: object, show_progress: bool) -> int:
+def _bc(args: argparse.Namespace) -> int:
     from gymfg_il import cli
     from gymfg_il.datasets.lerobot_api import hub_offline
-    from gymfg_il.learning.bc import TrainConfig, epochs_for, train_bc
+    from gymfg_il.learning.bc import train_bc
+    from gymfg_il.learning.config import TrainConfig
     from gymfg_il.learning.data import load_frames
+    from gymfg_il.learning.fit import Estimate
 
-    assert isinstance(cfg, TrainConfig)
+    cfg = cli.build(TrainConfig, args, policy=policy_config(args))
     hub_offline()
-    frames = load_frames(cfg.dataset, cfg.camera if cfg.policy == "vision" else None)
-    epochs = epochs_for(cfg, frames)
-    bar = cli.progress_bar(epochs, "epochs", "ep", show_progress)
+    frames = load_frames(cfg.dataset, cfg.policy.window.camera)
+    show = not args.no_progress
+    bar: Any = None
+
+    def on_start(estimate: Estimate) -> None:
+        nonlocal bar
+        print(
+            f"training {estimate.epochs} epoch(s) x {estimate.batches} batches of "
+            f"{cfg.batch_size} samples ({cfg.policy.window.describe()}): about "
+            f"{duration(estimate.seconds)} ({estimate.batch_s:.3g} s a batch, timed here)",
+            file=sys.stderr,
+        )
+        bar = cli.progress_bar(estimate.epochs, "epochs", "ep", show)
 
     def on_epoch(epoch: int, train: float, val: float) -> None:
         bar.update(1)
         bar.set_postfix(loss=f"{train:.4f}", val=f"{val:.4f}")
 
-    result = train_bc(cfg, on_epoch, frames)
+    result = train_bc(cfg, on_epoch, frames, on_start)
     bar.close()
     print(
         f"trained {result.meta['name']} on {result.meta['train']['train_frames']} frames "
@@ -58,6 +94,98 @@ def _bc(cfg: object, show_progress: bool) -> int:
     if result.overfit:
         print(f"warning: {result.overfit}", file=sys.stderr)
     return 0
+
+
+def policy_settings() -> type:
+    """The settings of every registered policy type as one dataclass of optional fields, one
+    per name (a setting several types share is one flag; given a list where a type's setting
+    is one value, that type takes the first), each documented for every type it belongs to."""
+    from gymfg_il import cli
+    from gymfg_il.learning.config import TrainConfig
+    from gymfg_il.policies.factory import policy_types
+
+    kinds: dict[str, Any] = {}
+    uses: dict[str, dict[str, list[str]]] = {}  # name -> its text -> the types it is theirs
+    for name, ptype in policy_types().items():
+        docs, hints = cli.field_docs(ptype.config), typing.get_type_hints(ptype.config)
+        for f in dataclasses.fields(ptype.config):
+            if not f.metadata.get("cli", True):
+                continue
+            kind, known = hints[f.name], kinds.get(f.name)
+            if known is not None and _element(known) != _element(kind):
+                raise TypeError(f"policy {name}: setting {f.name}: {kind} clashes with {known}")
+            if known is None or typing.get_origin(kind) is list:
+                kinds[f.name] = kind
+            text = f"{docs.get(f.name, '')} (default: {_default(f)})"
+            uses.setdefault(f.name, {}).setdefault(text, []).append(name)
+    taken = {f.name for f in dataclasses.fields(TrainConfig)} & set(kinds)
+    if taken:
+        raise TypeError(f"policy settings {sorted(taken)} clash with train bc's own flags")
+    doc = "Attributes:\n" + "".join(
+        f"    {setting}: "
+        + "; ".join(f"{', '.join(names)}: {text}" for text, names in texts.items())
+        + "\n"
+        for setting, texts in uses.items()
+    )
+    fields = [(n, kinds[n] | None, dataclasses.field(default=None)) for n in kinds]
+    settings = dataclasses.make_dataclass("PolicySettings", fields)
+    settings.__doc__ = doc
+    return settings
+
+
+def policy_config(args: argparse.Namespace) -> Any:
+    """The configuration of ``args.policy`` with the settings given on the command line (the
+    rest at its defaults); a setting given that the type does not have is named on stderr."""
+    from gymfg_il.policies.factory import policy_type
+
+    ptype = policy_type(args.policy)
+    own = {f.name: f for f in dataclasses.fields(ptype.config) if f.metadata.get("cli", True)}
+    hints = typing.get_type_hints(ptype.config)
+    values = {}
+    for name in (f.name for f in dataclasses.fields(policy_settings())):
+        if not hasattr(args, name):
+            continue
+        value = getattr(args, name)
+        if name not in own:
+            flag = "--" + name.replace("_", "-")
+            print(
+                f"warning: {flag} is no setting of a {ptype.name} policy: ignored", file=sys.stderr
+            )
+            continue
+        if isinstance(value, list) and typing.get_origin(hints[name]) is not list:
+            value = value[0]
+        values[name] = value
+    return ptype.config(**values)
+
+
+def _default(f: dataclasses.Field[Any]) -> Any:
+    if f.default_factory is not dataclasses.MISSING:
+        return f.default_factory()
+    return f.default
+
+
+def _element(kind: Any) -> Any:
+    """The type of one value of ``kind`` (``int`` for ``list[int]`` and ``int``)."""
+    return typing.get_args(kind)[0] if typing.get_origin(kind) is list else kind
+
+
+def _first_sentence(cls: type) -> str:
+    from gymfg_il import cli
+
+    text = cli.summary(cls).split(". ")[0].rstrip(".").replace("``", "")
+    return text[:1].lower() + text[1:]
+
+
+def duration(seconds: float) -> str:
+    """``seconds`` as a person reads a wait: "40 s", "3 min 20 s", "1 h 05 min"."""
+    s = round(seconds)
+    if s < 1:
+        return "under a second"
+    if s < 60:
+        return f"{s} s"
+    if s < 3600:
+        return f"{s // 60} min {s % 60:02d} s"
+    return f"{s // 3600} h {s % 3600 // 60:02d} min"
 
 
 if __name__ == "__main__":

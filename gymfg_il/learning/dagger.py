@@ -99,7 +99,9 @@ def run_dagger(
 ) -> list[DaggerIteration]:
     """``iterations`` rounds of fly / label / aggregate / retrain, starting from ``policy``."""
     from gymfg_il.datasets.from_logs import build_from_logs
-    from gymfg_il.learning.bc import TrainConfig, train_bc
+    from gymfg_il.learning.bc import train_bc
+    from gymfg_il.learning.config import TrainConfig
+    from gymfg_il.policies.factory import policy_type
 
     if iterations < 1 or episodes < 1:
         raise ConfigError("iterations and episodes must be >= 1")
@@ -134,10 +136,14 @@ def run_dagger(
     cameras = root_meta.video_keys
     views = [k.removeprefix(IMAGE_PREFIX) for k in cameras]
     size = int(root_meta.features[cameras[0]]["shape"][0]) if cameras else 128
-    known = {f.name for f in fields(TrainConfig)}
-    train_args = {k: v for k, v in meta.get("train", {}).items() if k in known}
-    if meta.get("type") == "vision":  # checkpoints before 2026-11-24 recorded the frame
-        train_args["frames"] = meta["policy"]["frames"]  # count under "frames" (32,400)
+    # the policy's settings as it was trained (config.json's ``policy``; older checkpoints
+    # also listed some under ``train``, which is read for the run's settings only)
+    settings = dict(meta["policy"])
+    train_args: dict[str, Any] = {
+        "policy": policy_type(settings.get("type", meta["type"])).config.from_dict(settings)
+    }
+    known = {f.name for f in fields(TrainConfig)} - {"policy"}
+    train_args.update({k: v for k, v in meta.get("train", {}).items() if k in known})
     train_args.update(train_overrides or {})
     current = Path(policy)
     history = []

@@ -1,13 +1,10 @@
-"""A LeRobot dataset as in-memory tensors, batched by indexing (no per-item Python).
-
-The dataset is opened with LeRobot's own ``LeRobotDataset``; its columns are taken from the
-Arrow table underneath in one piece each. An epoch is a permutation of frame indices (or of
-window starts, for recurrent policies); a batch is one gather.
-"""
+"""A LeRobot dataset in memory (``Frames``): opened with LeRobot's own ``LeRobotDataset``,
+its columns taken from the Arrow table underneath in one piece each; which flight its
+episodes were flown in; and the split into training and validation episodes. The training
+samples are gathered from it in ``learning.batches``."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -267,106 +264,3 @@ def split_by_episode(
     rng = np.random.default_rng(seed)
     val = rng.choice(ids, n_val, replace=False)
     return frames.select(np.setdiff1d(ids, val)), frames.select(val)
-
-
-def chunk_indices(
-    frames: Frames, history: int, chunk: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """For every frame: the indices of its observation history (the current frame last,
-    repeating the first frame of its stretch at the start), of its action chunk (the current
-    frame first), and which chunk entries lie inside its stretch. A stretch is a run of
-    consecutive frames of one episode (a takeover dataset has gaps)."""
-    n = len(frames)
-    breaks = np.ones(n, bool)
-    breaks[1:] = (frames.episode[1:] != frames.episode[:-1]) | (
-        frames.frame[1:] != frames.frame[:-1] + 1
-    )
-    first_of = np.flatnonzero(breaks)
-    stretch = np.cumsum(breaks) - 1
-    first = first_of[stretch]
-    last = np.append(first_of[1:] - 1, n - 1)[stretch]
-    i = np.arange(n)
-    past = np.maximum(i[:, None] - np.arange(history - 1, -1, -1), first[:, None])
-    ahead = i[:, None] + np.arange(chunk)
-    inside = ahead <= last[:, None]
-    return past, np.minimum(ahead, last[:, None]), inside
-
-
-class TensorBatches:
-    """Shuffled batches from tensors on ``device``: frames, windows of ``sequence`` steps
-    that never cross an episode boundary, (``chunks`` = (history, chunk)) observation
-    histories with the action chunks that follow them (NaN past an episode's end), or
-    (``stack`` = n) the last n camera frames (averaged over ``pool`` x ``pool`` pixels) with
-    the observation, as ``(frames, obs)``."""
-
-    def __init__(
-        self,
-        frames: Frames,
-        batch_size: int,
-        device: str = "cpu",
-        sequence: int | None = None,
-        seed: int = 0,
-        chunks: tuple[int, int] | None = None,
-        stack: int | None = None,
-        pool: int = 1,
-    ) -> None:
-        import torch
-
-        self.torch = torch
-        self.obs = torch.as_tensor(frames.obs, device=device)
-        self.action = torch.as_tensor(frames.action, device=device)
-        self.batch_size = batch_size
-        self.sequence = sequence
-        self.chunks = None
-        self.images: Any = None
-        self.past: Any = None
-        if stack is not None:
-            if frames.images is None:
-                raise ConfigError("a vision policy needs the dataset's camera frames")
-            from gymfg_il.policies.modeling_vision import pool_frames
-
-            images = torch.as_tensor(frames.images)
-            self.images = torch.cat(
-                [pool_frames(images[i : i + 4096], pool) for i in range(0, len(images), 4096)]
-            ).to(device)
-            self.past = torch.as_tensor(chunk_indices(frames, stack, 1)[0], device=device)
-        if chunks is not None:
-            past, ahead, inside = chunk_indices(frames, *chunks)
-            future = frames.action[ahead]
-            future[~inside] = np.nan
-            self.obs = self.obs[torch.as_tensor(past, device=device)]
-            self.action = torch.as_tensor(future, device=device)
-        if sequence is None:
-            starts: np.ndarray = np.arange(len(frames))
-        else:
-            # window i..i+sequence-1 stays inside one episode
-            ends = np.arange(len(frames)) + sequence - 1
-            ok = ends < len(frames)
-            ok[ok] &= frames.episode[ends[ok]] == frames.episode[ok]
-            ok[ok] &= frames.frame[ends[ok]] - frames.frame[ok] == sequence - 1  # no gaps
-            starts = np.flatnonzero(ok)
-            if len(starts) == 0:
-                raise ConfigError(
-                    f"no episode (nor, in a takeover dataset, a person's takeover) is {sequence} "
-                    "steps long; lower sequence_length"
-                )
-        self.starts = torch.as_tensor(starts, device=device)
-        self.offsets = torch.arange(sequence or 1, device=device)
-        self.generator = torch.Generator(device="cpu").manual_seed(seed)
-
-    def __len__(self) -> int:
-        return (len(self.starts) + self.batch_size - 1) // self.batch_size
-
-    def __iter__(self) -> Iterator[tuple[Any, Any]]:
-        torch = self.torch
-        order = self.starts[
-            torch.randperm(len(self.starts), generator=self.generator).to(self.starts.device)
-        ]
-        for i in range(0, len(order), self.batch_size):
-            idx = order[i : i + self.batch_size]
-            if self.sequence is not None:
-                idx = idx[:, None] + self.offsets
-            if self.images is not None:
-                yield (self.images[self.past[idx]], self.obs[idx]), self.action[idx]
-                continue
-            yield self.obs[idx], self.action[idx]

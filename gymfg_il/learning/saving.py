@@ -44,14 +44,15 @@ def save_run(
 ) -> None:
     """Save the policy, its loss curve and log as the folder ``out``, replacing any older
     policy there in one step."""
+    from gymfg_il.policies.checkpoint import save_policy
     from gymfg_il.policies.checkpoint_folder import staged
-    from gymfg_il.policies.factory import save_policy
 
     train, val = losses
     try:
         with staged(out) as folder:
             save_policy(policy, folder, meta, *stats)
-            plot_losses(train, val, folder / "loss.png", str(meta["name"]))
+            label = getattr(policy, "loss_label", "loss")
+            plot_losses(train, val, folder / "loss.png", str(meta["name"]), label)
             text = json.dumps({"train_loss": train, "val_loss": val}, indent=1)
             (folder / "train_log.json").write_text(text)
     except OSError as err:
@@ -60,11 +61,25 @@ def save_run(
         ) from None
 
 
-def plot_losses(train: list[float], val: list[float], path: Path, title: str) -> None:
+def plot_losses(
+    train: list[float], val: list[float], path: Path, title: str, label: str = "loss"
+) -> None:
+    """Save ``loss_figure`` to ``path``."""
+    import matplotlib.pyplot as plt
+
+    fig = loss_figure(train, val, title, label)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def loss_figure(train: list[float], val: list[float], title: str, label: str) -> Any:
+    """The loss of every epoch, training and validation, on a log scale over whole epochs;
+    ``label`` says what the loss is (the policy's ``loss_label``)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     fig, ax = plt.subplots(figsize=(6, 3.5))
     epochs = np.arange(1, len(train) + 1)
@@ -72,9 +87,9 @@ def plot_losses(train: list[float], val: list[float], path: Path, title: str) ->
     if not all(math.isnan(v) for v in val):
         ax.semilogy(epochs, val, label="validation (held-out episodes)")
     ax.set_xlabel("epoch")
-    ax.set_ylabel("MSE (normalised actions)")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_ylabel(label)
     ax.set_title(title)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return fig

@@ -29,7 +29,7 @@ class PolicyAgent:
 
     @classmethod
     def load(cls, path: Path, device: str = "cpu") -> PolicyAgent:
-        from gymfg_il.policies.factory import load_policy
+        from gymfg_il.policies.checkpoint import load_policy
 
         policy, meta = load_policy(path, device)
         return cls(policy, meta, device)

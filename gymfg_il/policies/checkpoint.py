@@ -1,59 +1,18 @@
-"""Finding policies by name, and saving/loading checkpoints (safetensors + JSON config)."""
+"""A trained policy on disk: ``config.json`` (its type, its settings, the dataset's statistics
+and what the training run records) beside ``model.safetensors`` (its weights)."""
 
 from __future__ import annotations
 
 import json
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.policies.configuration_chunk import ChunkConfig
-from gymfg_il.policies.configuration_gru import GRUConfig
-from gymfg_il.policies.configuration_mlp import MLPConfig
-from gymfg_il.policies.configuration_vision import VisionConfig
+from gymfg_il.policies.factory import make_policy, policy_type
 
-PolicyConfig = MLPConfig | GRUConfig | ChunkConfig | VisionConfig
-CONFIGS: dict[str, type] = {
-    "mlp": MLPConfig,
-    "gru": GRUConfig,
-    "chunk": ChunkConfig,
-    "vision": VisionConfig,
-}
 CONFIG_FILE, WEIGHTS_FILE = "config.json", "model.safetensors"
-
-
-def make_config(kind: str, **kwargs: Any) -> PolicyConfig:
-    try:
-        cls = CONFIGS[kind]
-    except KeyError:
-        raise ConfigError(f"unknown policy {kind!r}; choose one of {sorted(CONFIGS)}") from None
-    return cls(**kwargs)
-
-
-def make_policy(
-    config: PolicyConfig,
-    obs_stats: dict[str, np.ndarray],
-    action_stats: dict[str, np.ndarray],
-) -> Any:
-    """A fresh policy module for ``config`` with normalisation from the given statistics."""
-    if config.type == "mlp":
-        from gymfg_il.policies.modeling_mlp import MLPPolicy
-
-        return MLPPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
-    if config.type == "chunk":
-        from gymfg_il.policies.modeling_chunk import ChunkPolicy
-
-        return ChunkPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
-    if config.type == "vision":
-        from gymfg_il.policies.modeling_vision import VisionPolicy
-
-        return VisionPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
-    from gymfg_il.policies.modeling_gru import GRUPolicy
-
-    return GRUPolicy(config, obs_stats, action_stats)  # type: ignore[arg-type]
 
 
 def _stats_json(stats: dict[str, np.ndarray]) -> dict[str, list[float]]:
@@ -72,9 +31,10 @@ def save_policy(
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    settings = policy.config.to_dict()
     config = {
-        "type": policy.config.type,
-        "policy": asdict(policy.config),
+        "type": settings["type"],
+        "policy": settings,
         "obs_stats": _stats_json(obs_stats),
         "action_stats": _stats_json(action_stats),
         **meta,
@@ -113,9 +73,8 @@ def load_policy(path: Path, device: str = "cpu") -> tuple[Any, dict[str, Any]]:
 
     meta = read_config(path)
     try:
-        policy_fields = dict(meta["policy"])
-        kind = policy_fields.pop("type", meta["type"])
-        config = make_config(kind, **policy_fields)
+        settings = dict(meta["policy"])
+        config = policy_type(settings.get("type", meta["type"])).config.from_dict(settings)
         obs = {k: np.array(v) for k, v in meta["obs_stats"].items()}
         act = {k: np.array(v) for k, v in meta["action_stats"].items()}
         policy = make_policy(config, obs, act)

@@ -4,24 +4,28 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from gymfg_il.errors import ConfigError
+from gymfg_il.policies.configuration import PolicyConfig
+from gymfg_il.policies.factory import register_policy
 
 
+@register_policy("mlp", "gymfg_il.policies.modeling_mlp:MLPPolicy")
 @dataclass
-class MLPConfig:
-    """A feed-forward policy on the normalised observation.
+class MLPConfig(PolicyConfig):
+    """One observation in, one action out: a feed-forward network on the normalised
+    observation.
 
     Attributes:
         hidden: widths of the hidden layers.
         dropout: dropout after each hidden layer (0 = none).
     """
 
-    type: str = "mlp"
     hidden: list[int] = field(default_factory=lambda: [256, 256])
     dropout: float = 0.0
 
-    def __post_init__(self) -> None:
-        if not self.hidden or not all(isinstance(h, int) and h > 0 for h in self.hidden):
-            raise ConfigError(f"hidden={self.hidden!r} must be a non-empty list of widths > 0")
+    def problems(self) -> list[str]:
+        problems = []
+        if not self.hidden or min(self.hidden) < 1:
+            problems.append(f"hidden={self.hidden!r} must be a non-empty list of widths > 0")
         if not 0.0 <= self.dropout < 1.0:
-            raise ConfigError(f"dropout={self.dropout!r} must lie in [0, 1)")
+            problems.append(f"dropout={self.dropout!r} must lie in [0, 1)")
+        return problems

@@ -17,9 +17,6 @@ from gymfg_il.policies.normalize import NormalizedPolicy
 
 
 class ChunkPolicy(NormalizedPolicy):
-    recurrent = False
-    chunked = True
-
     def __init__(
         self,
         config: ChunkConfig,

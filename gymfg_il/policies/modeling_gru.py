@@ -11,8 +11,6 @@ from gymfg_il.policies.normalize import NormalizedPolicy
 
 
 class GRUPolicy(NormalizedPolicy):
-    recurrent = True
-
     def __init__(
         self,
         config: GRUConfig,

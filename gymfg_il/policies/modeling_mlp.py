@@ -11,8 +11,6 @@ from gymfg_il.policies.normalize import NormalizedPolicy
 
 
 class MLPPolicy(NormalizedPolicy):
-    recurrent = False
-
     def __init__(
         self,
         config: MLPConfig,

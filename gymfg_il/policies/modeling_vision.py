@@ -16,6 +16,7 @@ from torch import nn
 
 from gymfg_il.policies.configuration_vision import ROLL_INVARIANT, VisionConfig
 from gymfg_il.policies.normalize import NormalizedPolicy
+from gymfg_il.policies.window import pool_frames
 from gymfg_il.units import DEG_TO_RAD, wrap_180
 
 
@@ -31,8 +32,6 @@ class VisionPolicy(NormalizedPolicy):
     hands_index: torch.Tensor
     eye_error: torch.Tensor
     kept_when_rolled: torch.Tensor
-    recurrent = False
-    needs_camera = True
 
     def __init__(
         self,
@@ -42,6 +41,7 @@ class VisionPolicy(NormalizedPolicy):
     ) -> None:
         super().__init__(config, obs_stats, action_stats)
         self.config: VisionConfig = config
+        self.loss_label = f"action MSE + {config.aux_weight:g} x eye MSE (normalised)"
         layers: list[nn.Module] = []
         width = 3 * config.frames
         for c in config.channels:
@@ -56,8 +56,8 @@ class VisionPolicy(NormalizedPolicy):
             nn.GELU(),
             nn.Linear(256, n_seen),
         )
-        for name in ("seen_index", "target_index", "error_index", "error_seen", "error_target",
-                     "integral_index", "integral_error"):  # fmt: skip
+        indices = ["seen_index", "target_index", "error_index", "error_seen", "error_target"]
+        for name in [*indices, "integral_index", "integral_error"]:
             self.register_buffer(name, torch.as_tensor(getattr(config, name), dtype=torch.long))
         limit = [v if v > 0 else math.inf for v in config.integral_limit]
         self.register_buffer("integral_limit", torch.as_tensor(limit, dtype=torch.float32))
@@ -200,14 +200,3 @@ class VisionPolicy(NormalizedPolicy):
         obs[:, self.error_index] = errors
         obs[:, self.integral_index] = integrals
         return self.action_norm.inverse(self.fly(obs)), (stack, integrals)
-
-
-def pool_frames(frames: torch.Tensor, pool: int) -> torch.Tensor:
-    """Frames (..., H, W, 3) uint8 averaged over ``pool`` x ``pool`` blocks and rounded back to
-    uint8: done once to a dataset's frames before training, and to every frame in flight, so
-    both see the same pixels (and training gathers 1 / pool^2 of the bytes)."""
-    if pool == 1:
-        return frames
-    *lead, h, w, c = frames.shape
-    blocks = frames.reshape(*lead, h // pool, pool, w // pool, pool, c).float()
-    return blocks.mean(dim=(-4, -2)).round().to(torch.uint8)

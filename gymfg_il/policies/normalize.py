@@ -28,7 +28,11 @@ class Normalizer(nn.Module):
 class NormalizedPolicy(nn.Module):
     """What every policy shares: its config and the observation and action normalisers, so
     the checkpoint carries the dataset's statistics. Subclasses build the network on
-    ``self.n_obs`` inputs and ``self.n_act`` (normalised) outputs."""
+    ``self.n_obs`` inputs and ``self.n_act`` (normalised) outputs, and define
+    ``loss(inputs, action)`` for a batch of their ``Window`` (``learning.batches``) and
+    ``act(inputs, state) -> (action, state)`` for one step of flight (``policies.agent``)."""
+
+    loss_label = "MSE (normalised actions)"  # what ``loss`` is, for the loss curve
 
     def __init__(
         self, config: object, obs_stats: dict[str, np.ndarray], action_stats: dict[str, np.ndarray]

@@ -39,7 +39,7 @@ class AgentSpec:
         time and size of its config and weights (one retrained in place is loaded afresh)."""
         if self.path is None:
             return repr(self)
-        from gymfg_il.policies.factory import CONFIG_FILE, WEIGHTS_FILE
+        from gymfg_il.policies.checkpoint import CONFIG_FILE, WEIGHTS_FILE
         from gymfg_il.policies.lerobot_checkpoint import find_pretrained
 
         folder = find_pretrained(self.path) or self.path
@@ -55,7 +55,7 @@ class AgentSpec:
     def meta(self) -> dict[str, Any]:
         """A policy's ``config.json`` (for a LeRobot checkpoint, what its config says of it:
         ``policies.lerobot_checkpoint.lerobot_meta``)."""
-        from gymfg_il.policies.factory import read_config
+        from gymfg_il.policies.checkpoint import read_config
         from gymfg_il.policies.lerobot_checkpoint import find_pretrained, lerobot_meta
 
         assert self.path is not None

@@ -7,9 +7,13 @@ from gymfg_il.agent import ConstantAgent
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.errors import ConfigError
 from gymfg_il.evaluation.trace import trace_of
-from gymfg_il.learning.bc import TrainConfig, train_bc
-from gymfg_il.learning.data import TensorBatches, load_frames, split_by_episode
+from gymfg_il.learning.batches import TensorBatches
+from gymfg_il.learning.bc import train_bc
+from gymfg_il.learning.config import TrainConfig
+from gymfg_il.learning.data import load_frames, split_by_episode
 from gymfg_il.policies.agent import PolicyAgent
+from gymfg_il.policies.configuration_gru import GRUConfig
+from gymfg_il.policies.factory import make_config
 from gymfg_il.rollout import Rollout
 
 
@@ -58,10 +62,8 @@ def test_gru_policy_trains_and_flies(tiny_dataset, tmp_path):
         TrainConfig(
             dataset=tiny_dataset,
             out=tmp_path,
-            policy="gru",
+            policy=GRUConfig(hidden=32, sequence_length=8),
             epochs=4,
-            hidden=[32],
-            sequence_length=8,
         )
     )
     assert result.train_loss[-1] < result.train_loss[0]
@@ -77,7 +79,7 @@ def test_batches_and_split(tiny_dataset):
     train, val = split_by_episode(frames, 0.34, seed=0)
     assert val is not None
     assert not set(np.unique(train.episode)) & set(np.unique(val.episode))
-    windows = TensorBatches(train, 64, sequence=16, seed=0)
+    windows = TensorBatches(train, 64, seed=0, window=GRUConfig(sequence_length=16).window)
     seen = 0
     for obs, act in windows:
         assert obs.shape[1:] == (16, frames.obs.shape[1]) and act.shape[1:] == (16, 4)
@@ -103,7 +105,7 @@ def test_human_gated_episodes_teach_only_their_takeovers(tiny_dataset):
     assert len(kept) == len(frames) - (frames.episode == 1).sum() + 20
     assert (kept.frame[kept.episode == 1] == frames.frame[took]).all()
     # a GRU window never spans the gaps the policy's own frames leave
-    windows = TensorBatches(kept, 8, sequence=10, seed=0)
+    windows = TensorBatches(kept, 8, seed=0, window=GRUConfig(sequence_length=10).window)
     starts = windows.starts.numpy()
     assert (kept.frame[starts + 9] - kept.frame[starts] == 9).all()
     assert (kept.episode[starts] == 1).sum() == 20 - 9
@@ -114,6 +116,10 @@ def test_bad_training_inputs(tmp_path):
         train_bc(TrainConfig(dataset=tmp_path / "missing", epochs=1))
     with pytest.raises(ConfigError, match="policy='transformer'"):
         TrainConfig(policy="transformer")
+    with pytest.raises(ConfigError, match="unknown policy 'transformer'; choose one of mlp"):
+        make_config("transformer")
+    with pytest.raises(ConfigError, match="sequence_length=1 must be >= 2"):
+        make_config("gru", sequence_length=1)
     with pytest.raises(ConfigError, match="2 problems"):
         TrainConfig(lr=-1, val_fraction=1.5)
 
@@ -127,7 +133,7 @@ def test_policy_refuses_the_wrong_task(trained):
 
 
 def test_default_epochs_follow_who_demonstrated(tiny_dataset):
-    from gymfg_il.learning.bc import EPOCHS_AUTOPILOT, EPOCHS_PERSON, default_epochs
+    from gymfg_il.learning.config import EPOCHS_AUTOPILOT, EPOCHS_PERSON, default_epochs
 
     frames = load_frames(tiny_dataset)
     assert default_epochs(frames) == EPOCHS_AUTOPILOT == 60

@@ -8,8 +8,10 @@ import torch
 from gymfg_il.agent import ConstantAgent
 from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.evaluation.trace import trace_of
-from gymfg_il.learning.bc import TrainConfig, train_bc
-from gymfg_il.learning.data import Frames, TensorBatches, chunk_indices
+from gymfg_il.learning.batches import TensorBatches, window_indices
+from gymfg_il.learning.bc import train_bc
+from gymfg_il.learning.config import TrainConfig
+from gymfg_il.learning.data import Frames
 from gymfg_il.policies.agent import PolicyAgent
 from gymfg_il.policies.configuration_chunk import ChunkConfig
 from gymfg_il.policies.modeling_chunk import ChunkPolicy
@@ -35,12 +37,15 @@ def frames_of(episodes, frame_numbers):
 def test_histories_and_chunks_stay_inside_their_stretch():
     # episode 0: frames 0-3; episode 1: frames 0-1, then a gap (a takeover), frames 5-6
     frames = frames_of([0, 0, 0, 0, 1, 1, 1, 1], [0, 1, 2, 3, 0, 1, 5, 6])
-    past, ahead, inside = chunk_indices(frames, history=3, chunk=3)
+    window = ChunkConfig(history=3, chunk=3).window
+    assert window.observation == (-2, -1, 0) and window.action == (0, 1, 2)
+    past, _ = window_indices(frames, window.observation)
+    ahead, inside = window_indices(frames, window.action)
     assert past[0].tolist() == [0, 0, 0] and past[3].tolist() == [1, 2, 3]
     assert past[4].tolist() == [4, 4, 4] and past[6].tolist() == [6, 6, 6]  # after the gap
     assert ahead[2].tolist() == [2, 3, 3] and inside[2].tolist() == [True, True, False]
     assert inside[5].tolist() == [True, False, False]  # the gap ends its stretch
-    batches = TensorBatches(frames, 8, chunks=(3, 3))
+    batches = TensorBatches(frames, 8, window=window)
     ((obs, act),) = list(batches)
     assert obs.shape == (8, 3, 2) and act.shape == (8, 3, 4)
     assert int(torch.isnan(act[:, :, 0]).sum()) == int((~inside).sum())
@@ -72,16 +77,14 @@ def test_chunk_policy_trains_and_flies(tiny_dataset, tmp_path, far_target_seeds)
         TrainConfig(
             dataset=tiny_dataset,
             out=tmp_path,
-            policy="chunk",
+            policy=ChunkConfig(hidden=[64], history=3, chunk=5),
             epochs=10,
-            hidden=[64],
-            history=3,
-            chunk=5,
         )
     )
     assert result.train_loss[-1] < 0.6 * result.train_loss[0]
-    assert result.meta["train"]["chunk"] == 5
+    assert result.meta["train"]["policy"] == "chunk"
     agent = PolicyAgent.load(tmp_path)
+    assert agent.policy.config == ChunkConfig(hidden=[64], history=3, chunk=5)
     env = AircraftEnv("altitude", "c172p", episode_time_s=60)
     zero = ConstantAgent((0.0, 0.0, 0.0, env.aircraft.profile.cruise_throttle))
     (seed,) = far_target_seeds(env, 1)

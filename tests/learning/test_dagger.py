@@ -6,7 +6,8 @@ from gymfg_il.collectors.autopilot import record_autopilot
 from gymfg_il.collectors.config import CollectConfig
 from gymfg_il.datasets.from_logs import build_from_logs
 from gymfg_il.envs.flight import FlightSpec
-from gymfg_il.learning.bc import TrainConfig, train_bc
+from gymfg_il.learning.bc import train_bc
+from gymfg_il.learning.config import TrainConfig
 from gymfg_il.learning.dagger import run_dagger
 from gymfg_il.learning.data import load_frames
 from gymfg_il.rollout import AgentSpec, fly_many

@@ -10,8 +10,10 @@ import pytest
 
 from gymfg_il.collectors.autopilot import collect_autopilot
 from gymfg_il.collectors.config import CollectConfig
-from gymfg_il.evaluation.config import EvalConfig, run_eval
-from gymfg_il.learning.bc import TrainConfig, TrainResult, train_bc
+from gymfg_il.evaluation.config import EvalConfig
+from gymfg_il.evaluation.runner import run_eval
+from gymfg_il.learning.bc import TrainResult, train_bc
+from gymfg_il.learning.config import TrainConfig
 
 
 # altitude needs the 40 demonstrations: from 20, its policy holds the 50-ft tolerance

@@ -270,11 +270,18 @@ def test_train_refuses_settings_that_cannot_train(tmp_path, capsys, args, needle
 def test_a_run_that_diverges_saves_nothing(tmp_path):
     """A step size inside the bounds that still blows the loss up: the run stops with an
     error at the first non-finite epoch, and nothing is written."""
-    from gymfg_il.learning.bc import TrainConfig, train_bc
+    from gymfg_il.learning.bc import train_bc
+    from gymfg_il.learning.config import TrainConfig
     from gymfg_il.learning.saving import DivergedError
+    from gymfg_il.policies.configuration_mlp import MLPConfig
 
     cfg = TrainConfig(
-        dataset=SAMPLE, out=tmp_path / "p", epochs=3, hidden=[16], lr=1.0, obs_noise=1e300
+        dataset=SAMPLE,
+        out=tmp_path / "p",
+        epochs=3,
+        policy=MLPConfig(hidden=[16]),
+        lr=1.0,
+        obs_noise=1e300,
     )
     with pytest.raises(DivergedError, match="diverged in epoch 1") as err:
         train_bc(cfg)
@@ -342,7 +349,7 @@ def old_policy(tmp_path_factory):
     ],
 )
 def test_a_save_killed_at_any_point_leaves_one_whole_policy(old_policy, tmp_path, where, survivor):
-    from gymfg_il.policies.factory import load_policy
+    from gymfg_il.policies.checkpoint import load_policy
 
     out = tmp_path / "p"
     shutil.copytree(old_policy, out)

@@ -9,7 +9,8 @@ from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.features import dataset_features
 from gymfg_il.datasets.from_logs import build_from_logs, episode_columns, episode_metadata
 from gymfg_il.errors import MixedTasksError
-from gymfg_il.learning.bc import TrainConfig, train_bc
+from gymfg_il.learning.bc import train_bc
+from gymfg_il.learning.config import TrainConfig
 from gymfg_il.recording.reader import read_log
 
 

@@ -12,11 +12,14 @@ from gymfg_il.collectors.autopilot import collect_autopilot
 from gymfg_il.collectors.config import CollectConfig
 from gymfg_il.errors import ConfigError
 from gymfg_il.evaluation.trace import trace_of
-from gymfg_il.learning.bc import TrainConfig, train_bc
-from gymfg_il.learning.data import TensorBatches, load_frames
+from gymfg_il.learning.batches import TensorBatches
+from gymfg_il.learning.bc import train_bc
+from gymfg_il.learning.config import TrainConfig
+from gymfg_il.learning.data import load_frames
 from gymfg_il.policies.agent import PolicyAgent
 from gymfg_il.policies.configuration_vision import VisionConfig
-from gymfg_il.policies.modeling_vision import VisionPolicy, pool_frames
+from gymfg_il.policies.modeling_vision import VisionPolicy
+from gymfg_il.policies.window import pool_frames
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.loop import Rollout
 from gymfg_il.sim.properties import INDEX
@@ -34,7 +37,9 @@ def roll_images(tmp_path_factory):
 def test_batches_stack_each_frame_with_the_one_before_inside_its_episode(roll_images):
     frames = load_frames(roll_images, camera="front")
     assert frames.images.shape == (800, 128, 128, 3) and frames.camera == "front"
-    batches = TensorBatches(frames, 64, stack=2, pool=2, seed=1)
+    window = VisionConfig(frames=2, pool=2).window
+    assert window.images == (-1, 0) and window.camera == "front" and window.pool == 2
+    batches = TensorBatches(frames, 64, seed=1, window=window)
     (images, obs), act = next(iter(batches))
     assert images.shape == (64, 2, 64, 64, 3) and images.dtype == torch.uint8
     assert obs.shape == (64, 13) and act.shape == (64, 4)
@@ -43,12 +48,12 @@ def test_batches_stack_each_frame_with_the_one_before_inside_its_episode(roll_im
     starts = np.flatnonzero(frames.frame == 0)
     for k, i in ((0, starts[1]), (1, starts[1] + 5)):
         want = torch.stack([pooled[max(i - 1, starts[1])], pooled[i]])
-        assert torch.equal(batches.images[batches.past[i]], want), k
+        assert torch.equal(batches.images[batches.index["images"][i]], want), k
 
 
 def test_a_vision_policy_trains_and_flies_by_the_envs_camera(roll_images, tmp_path):
     cfg = TrainConfig(
-        dataset=roll_images, out=tmp_path, policy="vision", epochs=3, hidden=[64], threads=2
+        dataset=roll_images, out=tmp_path, policy=VisionConfig(hidden=[64]), epochs=3, threads=2
     )
     result = train_bc(cfg)
     assert result.train_loss[-1] < result.train_loss[0]

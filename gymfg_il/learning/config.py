@@ -1,0 +1,125 @@
+"""The settings of a behaviour-cloning run (``TrainConfig``) and the defaults that depend on
+the data: how many epochs, which device."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.policies.configuration import PolicyConfig
+from gymfg_il.policies.configuration_mlp import MLPConfig
+from gymfg_il.typecheck import type_problems
+
+DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
+EPOCHS_AUTOPILOT, EPOCHS_PERSON = 60, 20  # the default epochs (TrainConfig.epochs)
+
+
+@dataclass
+class TrainConfig:
+    """Behaviour-cloning run.
+
+    Attributes:
+        dataset: LeRobot dataset folder (default: the bundled sample).
+        out: where the checkpoint goes (default: policies/bc-<task>-<aircraft>-<policy>).
+        policy: the policy trained: a registered policy configuration
+            (``policies.factory``) with its settings; on the command line ``--policy`` names
+            its type and each setting is a flag of its own.
+        epochs: passes over the training samples (default: 60 for an autopilot's
+            demonstrations, 20 where a person or the synthetic pilot flew any of them;
+            a policy type may cap it, vision at 20).
+        batch_size: samples (frames, or a policy's windows of frames) per gradient step.
+        lr: AdamW learning rate (cosine-decayed to 5 % over the run).
+        weight_decay: AdamW weight decay.
+        seed: seeds the split, the initialisation and the shuffling.
+        val_fraction: share of episodes held out for validation loss (whole episodes).
+        device: cpu, cuda, or auto (cuda when present).
+        obs_noise: std of Gaussian noise added to the normalised observations while training
+            (0 = none).
+        mixed_tasks: train one policy on episodes of different tasks that observe the same
+            variables (altitude with altitude-dynamic, say). Without it a dataset of several
+            tasks is refused, naming each task's episodes; tasks that observe different
+            variables are refused either way.
+        threads: CPU threads torch uses on cpu (0 = torch's own choice; default: the policy
+            type's, 1, or 0 for vision, whose convolutions gain from more).
+    """
+
+    dataset: Path = DEFAULT_DATASET
+    out: Path | None = None
+    policy: PolicyConfig = field(default_factory=MLPConfig, metadata={"cli": False})
+    epochs: int | None = None
+    batch_size: int = 256
+    lr: float = 1e-3
+    weight_decay: float = 1e-4
+    seed: int = 0
+    val_fraction: float = 0.1
+    device: str = "cpu"
+    obs_noise: float = 0.0
+    mixed_tasks: bool = False
+    threads: int | None = None
+
+    def __post_init__(self) -> None:
+        if isinstance(self.policy, str):
+            raise ConfigError(
+                f"policy={self.policy!r}: give a policy configuration, "
+                f"policies.factory.make_config({self.policy!r}, **settings)"
+            )
+        typed = type_problems(self)
+        if typed:
+            raise ConfigError(join_problems("train config", typed))
+        self.dataset = Path(self.dataset)
+        problems = []
+        if self.threads is not None and self.threads < 0:
+            problems.append(f"threads={self.threads}: want 0 (torch decides) or more")
+        if (self.epochs is not None and self.epochs < 1) or self.batch_size < 1:
+            problems.append("epochs and batch_size must be >= 1")
+        if not 0 < self.lr <= 1:  # AdamW moves each weight by about lr a step
+            problems.append(f"lr={self.lr} must lie in (0, 1] (default 1e-3)")
+        if not (self.weight_decay >= 0 and self.lr * self.weight_decay < 1):
+            problems.append(
+                f"weight_decay={self.weight_decay} must be >= 0 with lr x weight_decay < 1 "
+                "(each step shrinks the weights by that share)"
+            )
+        if not (self.obs_noise >= 0 and math.isfinite(self.obs_noise)):
+            problems.append(f"obs_noise={self.obs_noise} must be a number >= 0")
+        if not 0.0 <= self.val_fraction < 1.0:
+            problems.append(f"val_fraction={self.val_fraction} must lie in [0, 1)")
+        if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
+            problems.append(f"device={self.device!r}: use cpu, cuda, cuda:N or auto")
+        if problems:
+            raise ConfigError(join_problems("train config", problems))
+
+    @property
+    def threads_wanted(self) -> int:
+        """The CPU threads to train with: ``threads``, else the policy type's default."""
+        return self.threads if self.threads is not None else self.policy.default_threads
+
+
+def default_epochs(frames: Any) -> int:
+    """``EPOCHS_PERSON`` when a person or the synthetic pilot flew any demonstrated episode
+    (source ``human``, ``synthetic``, or a takeover ``<policy>+human``), else
+    ``EPOCHS_AUTOPILOT``."""
+    sources = frames.episodes.get("gymfg/source") or []
+    person = any(str(s).split("+")[-1] in ("human", "synthetic") for s in sources)
+    return EPOCHS_PERSON if person else EPOCHS_AUTOPILOT
+
+
+def epochs_for(cfg: TrainConfig, frames: Any) -> int:
+    """The epochs ``cfg`` trains for: its own, else the default for its data, capped by its
+    policy type's ``max_default_epochs``."""
+    if cfg.epochs:
+        return cfg.epochs
+    cap = cfg.policy.max_default_epochs
+    return default_epochs(frames) if cap is None else min(cap, default_epochs(frames))
+
+
+def resolve_device(device: str) -> str:
+    import torch
+
+    if device == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    if device.startswith("cuda") and not torch.cuda.is_available():
+        raise ConfigError(f"device={device!r} but no CUDA device is available; use cpu")
+    return device
