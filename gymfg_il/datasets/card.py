@@ -40,8 +40,8 @@ SOURCES = {
     "autopilot": "GymFG-IL's PID autopilot (`gymfg_il.controllers.autopilot`); no person flew",
     "human": "a person flying through GymFG-IL's manual controls (keyboard, mouse, joystick or "
     "a FlightGear cockpit); who they are and how much they have flown is not recorded",
-    "synthetic": "a model of a person flying with the keyboard (`gymfg_il.manual.synthetic`), "
-    "not a person",
+    "synthetic": "a model of a person flying through the manual controls' keyboard, mouse or "
+    "joystick events (`gymfg_il.manual.synthetic`), not a person",
     "dagger": "states a learned policy flew into, labelled by the task's autopilot: `action` is "
     "the autopilot's label, not what was flown",
 }
