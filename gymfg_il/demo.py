@@ -5,12 +5,16 @@
 2. behaviour cloning: an MLP policy on it;
 3. evaluation: the policy against the controller on held-out seeds (the demonstrations used
    seeds from 1000; evaluation uses 0..N-1);
-4. a report (table, JSON, Figure-1 plots, loss curve) written under ``runs/`` and its path
-   printed.
+4. a report (table, JSON, Figure-1 plots, loss curve) written under ``runs/<time>/`` and its
+   path printed; the policy is ``runs/<time>/bc-<type>`` (``bc-mlp``), its name in the table.
+
+Nothing is written until the demonstrations are at hand: outside the checkout, where neither
+the bundled sample nor its recipe is, the demo says so and leaves no run folder behind.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 import sys
@@ -19,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from gymfg_il.learning.bc import DEFAULT_DATASET, EPOCHS_AUTOPILOT
+from gymfg_il.learning.config import DEFAULT_DATASET, EPOCHS_AUTOPILOT
 
 RECIPE = Path("collectors/sample.toml")
 
@@ -84,25 +88,35 @@ def _bar(show: bool, unit: str) -> Callable[[int], Callable[..., None]]:
 
 def run(cfg: DemoConfig) -> int:
     from gymfg_il.datasets.lerobot_api import hub_offline
-    from gymfg_il.evaluation.config import EvalConfig, run_eval
-    from gymfg_il.learning.bc import TrainConfig, train_bc
+    from gymfg_il.evaluation.config import EvalConfig
+    from gymfg_il.evaluation.runner import run_eval
+    from gymfg_il.learning.bc import train_bc
+    from gymfg_il.learning.config import TrainConfig
 
     hub_offline()
     started = time.perf_counter()
-    run_dir = cfg.runs / time.strftime("%Y%m%d-%H%M%S")
-    run_dir.mkdir(parents=True, exist_ok=True)
     if not (cfg.dataset / "meta" / "info.json").is_file():
         from gymfg_il.collectors.autopilot import collect_autopilot
         from gymfg_il.collectors.config import CollectConfig
+        from gymfg_il.errors import ConfigError
 
+        if not RECIPE.is_file():
+            raise ConfigError(
+                f"no demonstrations at {cfg.dataset} and no recipe at {RECIPE} to collect them: "
+                "run the demo in the GymFG-IL checkout (make demo), or give --dataset DIR"
+            )
         print(f"[1/3] {cfg.dataset} is missing: collecting it with {RECIPE}", flush=True)
         recipe = CollectConfig.from_recipe(RECIPE, out=cfg.dataset.parent)
         collect_autopilot(recipe, cfg.workers, _bar(cfg.progress, "episode"))
     else:
         print(f"[1/3] demonstrations: {cfg.dataset}", flush=True)
-    policy = run_dir / "policy"
+    run_dir = cfg.runs / time.strftime("%Y%m%d-%H%M%S")
+    run_dir.mkdir(parents=True, exist_ok=True)
+    train = TrainConfig(dataset=cfg.dataset, epochs=cfg.epochs)
+    # the folder names the policy in the table and plots: policy:bc-mlp
+    policy = run_dir / f"bc-{train.policy.type}"
+    train = dataclasses.replace(train, out=policy)
     print(f"[2/3] behaviour cloning -> {policy}", flush=True)
-    train = TrainConfig(dataset=cfg.dataset, out=policy, epochs=cfg.epochs)
     epoch_tick = _bar(cfg.progress, "epoch")(cfg.epochs)
     trained = train_bc(train, lambda *_: epoch_tick())
     print(f"      validation loss {trained.val_loss[-1]:.4f}", flush=True)
