@@ -116,7 +116,7 @@ def _train(
     policy.obs_noise = cfg.obs_noise
     batches, val_batches = _batches(train, val, cfg, window, device)
     # the batches hold the pooled camera frames: the full-size ones of the split go (vision
-    # DAgger on 60 episodes ran out of 24 GiB with them kept), but the caller's
+    # DAgger on 60 episodes ran out of memory with them kept), but the caller's
     for part in (train, val):
         if part is not None and part is not given:
             part.images = None

@@ -19,6 +19,7 @@ from gymfg_il.datasets.episode_logs import link_base_logs
 from gymfg_il.datasets.videos import IMAGE_PREFIX
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
+from gymfg_il.learning.config import TrainConfig
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.workers import Workers
 
@@ -100,8 +101,6 @@ def run_dagger(
     """``iterations`` rounds of fly / label / aggregate / retrain, starting from ``policy``."""
     from gymfg_il.datasets.from_logs import build_from_logs
     from gymfg_il.learning.bc import train_bc
-    from gymfg_il.learning.config import TrainConfig
-    from gymfg_il.policies.factory import policy_type
 
     if iterations < 1 or episodes < 1:
         raise ConfigError("iterations and episodes must be >= 1")
@@ -136,15 +135,6 @@ def run_dagger(
     cameras = root_meta.video_keys
     views = [k.removeprefix(IMAGE_PREFIX) for k in cameras]
     size = int(root_meta.features[cameras[0]]["shape"][0]) if cameras else 128
-    # the policy's settings as it was trained (config.json's ``policy``; older checkpoints
-    # also listed some under ``train``, which is read for the run's settings only)
-    settings = dict(meta["policy"])
-    train_args: dict[str, Any] = {
-        "policy": policy_type(settings.get("type", meta["type"])).config.from_dict(settings)
-    }
-    known = {f.name for f in fields(TrainConfig)} - {"policy"}
-    train_args.update({k: v for k, v in meta.get("train", {}).items() if k in known})
-    train_args.update(train_overrides or {})
     current = Path(policy)
     history = []
     # one pool for every round, forked before training starts threads in this process
@@ -164,7 +154,7 @@ def run_dagger(
                 image_size=size,
             )
             report = build_from_logs(sorted((out / LOGS).glob("*.mcap")), root)
-            cfg = TrainConfig(**{**train_args, "dataset": root, "out": out / f"policy-{it}"})
+            cfg = retrain_config(meta, root, out / f"policy-{it}", train_overrides)
             result = train_bc(cfg)
             current = result.out
             step = DaggerIteration(
@@ -179,3 +169,19 @@ def run_dagger(
             if on_iteration is not None:
                 on_iteration(step)
     return history
+
+
+def retrain_config(
+    meta: dict[str, Any], dataset: Path, out: Path, overrides: dict[str, Any] | None = None
+) -> TrainConfig:
+    """The run that trains the policy of ``meta`` (its config.json) again on ``dataset``: its
+    type and settings (config.json's ``policy``) and the run's settings (``train``, of which
+    checkpoints written before the policy registry also listed policy settings, left out
+    here), with ``overrides``."""
+    from gymfg_il.policies.factory import policy_type
+
+    settings = dict(meta["policy"])
+    policy = policy_type(settings.get("type", meta["type"])).config.from_dict(settings)
+    known = {f.name for f in fields(TrainConfig)} - {"policy", "dataset", "out"}
+    run = {k: v for k, v in meta.get("train", {}).items() if k in known}
+    return TrainConfig(**{**run, **(overrides or {})}, policy=policy, dataset=dataset, out=out)
