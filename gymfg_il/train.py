@@ -71,9 +71,9 @@ def _bc(args: argparse.Namespace) -> int:
 
     def on_start(estimate: Estimate) -> None:
         nonlocal bar
+        samples = f"{cfg.batch_size} samples ({cfg.policy.window.describe()})"
         print(
-            f"training {estimate.epochs} epoch(s) x {estimate.batches} batches of "
-            f"{cfg.batch_size} samples ({cfg.policy.window.describe()}): about "
+            f"training {estimate.epochs} epoch(s) x {estimate.batches} batches of {samples}: "
             f"{duration(estimate.seconds)} ({estimate.batch_s:.3g} s a batch, timed here)",
             file=sys.stderr,
         )
@@ -177,15 +177,16 @@ def _first_sentence(cls: type) -> str:
 
 
 def duration(seconds: float) -> str:
-    """``seconds`` as a person reads a wait: "40 s", "3 min 20 s", "1 h 05 min"."""
+    """An estimate of ``seconds`` as a person reads a wait: "about 40 s", "about 3 min 20 s",
+    "about 1 h 05 min"."""
     s = round(seconds)
     if s < 1:
         return "under a second"
     if s < 60:
-        return f"{s} s"
+        return f"about {s} s"
     if s < 3600:
-        return f"{s // 60} min {s % 60:02d} s"
-    return f"{s // 3600} h {s % 3600 // 60:02d} min"
+        return f"about {s // 60} min {s % 60:02d} s"
+    return f"about {s // 3600} h {s % 3600 // 60:02d} min"
 
 
 if __name__ == "__main__":

@@ -56,7 +56,12 @@ def test_a_bad_setting_is_one_line_naming_it(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     "seconds, text",
-    [(0.2, "under a second"), (42, "42 s"), (200, "3 min 20 s"), (3900, "1 h 05 min")],
+    [
+        (0.2, "under a second"),
+        (42, "about 42 s"),
+        (200, "about 3 min 20 s"),
+        (3900, "about 1 h 05 min"),
+    ],
 )
 def test_durations_read_as_a_wait(seconds, text):
     assert train.duration(seconds) == text
