@@ -1,7 +1,7 @@
 #!/bin/bash
 # LeRobot's ACT, trained with LeRobot's own lerobot-train on CPU, beside our MLP and chunking
 # policies and the expert: 50 expert demonstrations of a maneuver (default flags), then our
-# eval on held-out seeds. The README's "LeRobot's own tools" figures.
+# eval on held-out seeds. The figures of docs/results/act.md.
 # Usage: bash docs/experiments/act.sh [OUT] [TASK] [EVAL_SEED] [STEPS]
 set -euo pipefail
 export HF_HUB_OFFLINE=1 SDL_VIDEODRIVER=dummy

@@ -1,5 +1,6 @@
-"""The frame strip of the README and the camera guide: an approach flown by the task's expert,
-seen by the headless camera (front view above, chase view below) at six moments.
+"""The frame strip of the README, the docs' front page and the camera guide: an approach
+flown by the task's expert, seen by the headless camera (front view above, chase view below)
+at six moments.
 
     python docs/experiments/camera_strip.py [OUT.png]   (default docs/images/camera_strip.png)
 """

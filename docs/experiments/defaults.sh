@@ -1,7 +1,7 @@
 #!/bin/bash
-# Default flags, 40 autopilot demonstrations -> train bc -> eval on held-out seeds (README,
-# "Defaults that fly"). Usage: bash docs/experiments/defaults.sh [OUT] [TASK-AIRCRAFT ...]
-# Environment: DEMOS (40), COLLECT_SEED (1000), EPISODES (16), EVAL_SEED (9000; the README's
+# Default flags, 40 autopilot demonstrations -> train bc -> eval on held-out seeds (docs/results/defaults.md,
+# "The target tasks"). Usage: bash docs/experiments/defaults.sh [OUT] [TASK-AIRCRAFT ...]
+# Environment: DEMOS (40), COLLECT_SEED (1000), EPISODES (16), EVAL_SEED (9000; the results page's
 # 8-episode rows: 9100),
 # COLLECT (extra collect flags, e.g. "--turbulence moderate"), EVAL (extra eval flags, e.g.
 # "--turbulence moderate" for the turbulence rows, with EPISODES=8 EVAL_SEED=9200).

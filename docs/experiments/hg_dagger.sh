@@ -1,6 +1,6 @@
 #!/bin/bash
 # Human-gated DAgger against plain BC on the same number of demonstrator frames, with the
-# synthetic pilot on the altitude task (README, "Defaults that fly").
+# synthetic pilot on the altitude task (docs/results/defaults.md, "Human-gated DAgger").
 # Usage: bash docs/experiments/hg_dagger.sh [OUT]
 set -euo pipefail
 export HF_HUB_OFFLINE=1 SDL_VIDEODRIVER=dummy

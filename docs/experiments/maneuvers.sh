@@ -1,10 +1,10 @@
 #!/bin/bash
-# The maneuvers table of the README ("Maneuvers"): for each maneuver, 50 expert demonstrations
+# The maneuvers tables of docs/results/maneuvers.md: for each maneuver, 50 expert demonstrations
 # (default flags) -> an MLP and a chunking policy -> eval beside the expert on held-out seeds;
 # then 50 synthetic-pilot keyboard demonstrations of turn and waypoints -> an MLP -> eval
 # beside the pilot. About 40 minutes on two cores.
 # Usage: bash docs/experiments/maneuvers.sh [OUT] [EVAL_SEED] [AIRCRAFT] [SEED]
-# (the README's figures: EVAL_SEED 5000, SEED 0 for the expert's demonstrations; the pilot's
+# (the page's figures: EVAL_SEED 5000, SEED 0 for the expert's demonstrations; the pilot's
 # are always collected from 2000 and evaluated from EVAL_SEED + 1000)
 set -euo pipefail
 export HF_HUB_OFFLINE=1 SDL_VIDEODRIVER=dummy

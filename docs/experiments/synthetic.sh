@@ -1,6 +1,6 @@
 #!/bin/bash
 # 30 synthetic-pilot keyboard demonstrations of altitude -> train bc -> eval beside the pilot
-# (README, "Defaults that fly": seeds 0/600, 2000/3000, 4000/5000).
+# (docs/results/defaults.md, "From the synthetic pilot": seeds 0/600, 2000/3000, 4000/5000).
 # Usage: bash docs/experiments/synthetic.sh [OUT] [SEED] [EVAL_SEED]
 set -euo pipefail
 export HF_HUB_OFFLINE=1 SDL_VIDEODRIVER=dummy

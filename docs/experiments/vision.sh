@@ -1,5 +1,5 @@
 #!/bin/bash
-# A vision policy against the state policy on roll (or TASK), c172p, default flags (README, "Seeing").
+# A vision policy against the state policy on roll (or TASK), c172p, default flags (docs/results/vision.md).
 # Usage: [TASK=heading] bash docs/experiments/vision.sh OUT [DEMOS] [COLLECT_SEED] [EVAL_SEED ...]
 # Prints each eval's table and the vision policy's share of the state policy's return.
 set -euo pipefail

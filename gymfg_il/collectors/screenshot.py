@@ -1,8 +1,8 @@
 """``python -m gymfg_il.collectors.screenshot PATH``: a PNG of the controls GUI in flight.
 
 Runs the manual session off-screen (``SDL_VIDEODRIVER=dummy``) with the controller assisting,
-injects a stick input, and saves the window after a few seconds; the README's picture is made
-by it.
+injects a stick input, and saves the window after a few seconds; the Fly-by-hand guide's
+picture (docs/images/gui.png) is made by it.
 """
 
 from __future__ import annotations

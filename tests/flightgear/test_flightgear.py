@@ -85,7 +85,7 @@ def test_flightgear_follows_jsbsim(display, tmp_path, free_udp_ports):
 
         shot = ImageGrab.grab(xdisplay=display)
         shot.save(tmp_path / "flightgear.png")
-        if os.environ.get("GYMFG_SCREENSHOT"):  # how docs/flightgear.png is made
+        if os.environ.get("GYMFG_SCREENSHOT"):  # how docs/images/flightgear.png is made
             shot.save(os.environ["GYMFG_SCREENSHOT"])
         log = fg.log_path.read_text(errors="replace")
         env.close()
