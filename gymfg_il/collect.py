@@ -24,12 +24,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from gymfg_il.collectors.config import MANUAL_HZ
+
 if TYPE_CHECKING:
     from gymfg_il.collectors.config import ManualConfig
 
 EPILOG = __doc__.split("\n\n", 1)[1]
-# a person's session: smooth at 30 Hz, until they quit, into a folder of its own
-MANUAL_DEFAULTS = {"agent_hz": 30, "episodes": 0, "out": Path("datasets/manual")}
+# a person's session: at the manual rate, until they quit, into a folder of its own
+MANUAL_DEFAULTS = {"agent_hz": MANUAL_HZ, "episodes": 0, "out": Path("datasets/manual")}
 
 
 def _workers(text: str) -> int:

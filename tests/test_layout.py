@@ -17,7 +17,7 @@ LAYERS = [
     {"flightgear"},
     {"tasks"},
     {"controllers"},
-    {"viz"},
+    {"viz", "display"},
     {"envs"},
     {"online"},
     {"policies", "manual"},

@@ -126,6 +126,11 @@ class CollectConfig(FlightOptions):
         return chosen(**{**table, **overrides})
 
 
+# a person's session flies at this rate unless told otherwise (what a person can follow
+# smoothly, and what the synthetic pilot, who stands in for one, is evaluated at)
+MANUAL_HZ = 30
+
+
 @dataclass
 class ManualConfig(CollectConfig):
     """A collection session flown through a device in a window, by a person or the synthetic

@@ -25,6 +25,8 @@ from gymfg_il.collectors.manual_keys import COMMAND_KEYS, help_lines
 from gymfg_il.collectors.manual_view import window_frame
 from gymfg_il.collectors.session import DATASET, check_appendable, check_out_folder
 from gymfg_il.collectors.updater import DatasetUpdater
+from gymfg_il.display.briefing import Debrief, briefing, debrief
+from gymfg_il.display.readings import Display, display_of
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.manual.bindings import (
@@ -152,7 +154,7 @@ class ManualSession:
         title = f"GymFG-IL: {flight.task_label} on {self.env.aircraft.model}"
         pilot_view = None if config.pilot_view == "none" else config.pilot_view
         self.camera = Camera(320, 320, view=pilot_view) if pilot_view and self.draw else None
-        self.gui = ControlsGUI(size=(1250, 600) if self.camera else (900, 600), title=title)
+        self.gui = ControlsGUI(size=(1250, 700) if self.camera else (900, 700), title=title)
         self.human.window_size = self.gui.size
         self.stats = SessionStats()
         self.state = "idle"
@@ -163,6 +165,20 @@ class ManualSession:
         self.message = "Space: start an episode"
         self.writer: TrajectoryWriter | None = None
         self.updater = DatasetUpdater(out)
+        self.briefing = briefing(self.env.task, self.env.world.max_steps * self.env.dt)
+        self.debrief: Debrief | None = None
+        tracked = self.env.task.tracked()
+        self._error_at = names.index(tracked["error"]) if tracked else None
+        self._flown: list[np.ndarray] = []  # this episode's states, the reset's first
+        self._errors: list[float] = []
+        self._return = 0.0
+        self.display = self._look()
+
+    def _look(self) -> Display:
+        """What the window shows now (``display.readings``): the pilot's only source."""
+        world = self.env.world
+        flying = self.state != "idle"
+        return display_of(self.env.task, world.slots[0].state, world.steps, flying)
 
     @property
     def human_flies(self) -> bool:
@@ -190,6 +206,8 @@ class ManualSession:
         self.updater.warm()  # its imports overlap the flying
         seed = self.next_seed
         starts = self.rollout.reset(seed)
+        self._flown, self._errors, self._return = [starts[0].state.copy()], [], 0.0
+        self.debrief = None
         self.step_count, self.interventions = 0, 0
         self._writer().start_episode(seed, starts, source=self.source)
         self.state, self.message, self.show_help = "recording", "", False
@@ -197,6 +215,10 @@ class ManualSession:
     def _finish(self, outcome: str) -> None:
         writer = self._writer()
         writer.end_episode(outcome=outcome, steps=self.step_count, interventions=self.interventions)
+        gusty = self.flight.turbulence != "none"
+        states, errors = np.array(self._flown), np.array(self._errors)
+        dt = self.env.dt
+        self.debrief = debrief(self.env.task, states, errors, dt, outcome, self._return, gusty)
         if self.build_each:
             self.updater.request()  # the dataset follows in a helper process, off the GIL
         self.stats.saved += 1
@@ -236,6 +258,10 @@ class ManualSession:
         self._writer().log_tick(tick)
         (step,) = tick.steps
         self.last_action = step.action
+        self._flown.append(step.state.copy())
+        self._return += step.reward
+        if self._error_at is not None:
+            self._errors.append(float(self.observation[self._error_at]))
         self.step_count += 1
         self.interventions += int(step.intervention)
         if tick.done:
@@ -258,6 +284,7 @@ class ManualSession:
                 if last_start is not None:
                     self.stats.periods.append(start - last_start)
                 last_start = start
+                self.display = self._look()
                 if self.on_frame is not None:
                     self.on_frame(frame, self)
                 events = pygame.event.get()
@@ -275,6 +302,7 @@ class ManualSession:
                     self._step()
                 self.updater.poll()
                 if self.draw:
+                    self.display = self._look()
                     self._draw()
                 frame += 1
                 self.stats.frames = frame

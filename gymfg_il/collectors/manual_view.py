@@ -1,6 +1,7 @@
-"""What the manual session's window shows each frame: the instruments (``SHOWN``), the
-tracked variable against its target, the stick, the session's state and, beside them, the
-pilot's camera."""
+"""What the manual session's window shows each frame: the display model of the moment (the
+session's ``display``: instruments, bugs, guidance), the state variables (``SHOWN``), the
+stick, the briefing before an episode and the debrief after it, the session's state and,
+beside them, the pilot's camera."""
 
 from __future__ import annotations
 
@@ -32,26 +33,23 @@ def window_frame(session: ManualSession) -> GuiFrame:
     world = env.world
     state = world.slots[0].state
     flying = session.state != "idle"
-    target = actual = None
-    target_name = ""
-    targets = [n for n in env.observation_names if n.endswith("_target")]
-    if targets and flying:
-        var = targets[0].removesuffix("_target")
-        target_name = f"{var} ({BY_NAME[var].unit})"
-        target = env.task.target_value(world.steps)
-        actual = float(state[INDEX[var]])
     steps_left = world.max_steps - world.steps if flying else world.max_steps
     human = session.human_flies or not flying
     view = None
     if session.camera is not None:
         marks = landmarks_of(env.task, getattr(env.task, "plan", None), world.steps)
         view = session.camera.frame(state, marks)
+    if flying:
+        notes = session.briefing[:2]
+    elif session.debrief is not None:
+        notes = list(session.debrief.lines)
+    else:
+        notes = session.briefing
     return GuiFrame(
         action=session.human.values if human else session.last_action,
         variables={n: (float(state[INDEX[n]]), BY_NAME[n].unit) for n in SHOWN},
-        target_name=target_name,
-        target=target,
-        actual=actual,
+        display=session.display,
+        notes=notes,
         episode=session.episode,
         time_left_s=max(0.0, steps_left * env.dt),
         status=session.state,

@@ -1,6 +1,7 @@
 """The synthetic pilot at the real collection session: it presses Space to start each episode
-and, while one is flown, puts its key, joystick or mouse events into pygame's queue, where
-the session loop reads them as it reads a person's (``collect manual --pilot synthetic``).
+and, while one is flown, looks at the session's display (what the window draws) and puts its
+key, joystick or mouse events into pygame's queue, where the session loop reads them as it
+reads a person's (``collect manual --pilot synthetic``).
 
 With an assistant (``--assist POLICY``) it is a human-gated DAgger teacher: it takes over (T)
 when the task's error grows past ``gate`` times the task's tolerance and hands back once the
@@ -11,8 +12,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from gymfg_il.manual.perception import DisplayIntent
 from gymfg_il.manual.synthetic import SyntheticPilot, key_codes
-from gymfg_il.rollout.agents import AgentSpec
 
 if TYPE_CHECKING:
     from gymfg_il.collectors.manual import ManualSession
@@ -50,7 +51,8 @@ class SyntheticDriver:
 
     def _build(self, session: ManualSession) -> SyntheticPilot:
         env = session.env
-        intent = AgentSpec.controller().make(env)
+        throttle = env.aircraft.profile.cruise_throttle
+        intent = DisplayIntent(env.task, env.aircraft.model, env.dt, throttle)
         pilot = SyntheticPilot(
             session.human.device,
             intent,
@@ -83,7 +85,7 @@ class SyntheticDriver:
         if session.pilot.assistant is not None:
             self._gate(session)
         if session.human_flies:
-            for event in self.pilot.events(session.observation, session.human.values):
+            for event in self.pilot.events(session.display, session.human.values):
                 _post_event(event)
             self.sent.append(list(self.pilot.sent))
         else:

@@ -4,11 +4,9 @@ control effort and smoothness.
 Definitions (per episode, then averaged over episodes):
 
 - success: the aircraft did not terminate and, for a maneuver, the task's own judge passed the
-  flown states (``ManeuverTask.judge``); for the target tasks ``|error| <= tolerance`` held
-  through the last
-  ``hold_s`` seconds (for dynamic targets the tolerance is ``tracking_factor`` x tolerance).
-  In turbulence a gust carries any aircraft past a calm-air tolerance for a moment, so there
-  the error must average within the tolerance over those seconds instead.
+  flown states (``ManeuverTask.judge``); for the target tasks the error held within the
+  tolerance through the last ``hold_s`` seconds (the rule of ``tasks.verdicts``: three times
+  the tolerance for a moving target, on the mean error in turbulence).
 - time_to_target_s: first time ``|error| <= tolerance`` (NaN if never; averaged over the
   episodes that reached it).
 - steady_state_error: mean ``|error|`` over the last ``hold_s`` seconds.
@@ -26,9 +24,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from gymfg_il.evaluation.trace import Trace
-
-HOLD_S = 10.0
-TRACKING_FACTOR = 3.0
+from gymfg_il.tasks.verdicts import HOLD_S, held
 
 
 @dataclass
@@ -49,7 +45,6 @@ def score_episode(ep: Trace, hold_s: float = HOLD_S) -> EpisodeScore:
     abs_err = np.abs(ep.error)
     hold = max(1, round(hold_s / ep.dt))
     tail = abs_err[-hold:]
-    tolerance = ep.tolerance * (TRACKING_FACTOR if ep.dynamic else 1.0)
     reached = np.flatnonzero(abs_err <= ep.tolerance)
     overshoot = 0.0
     if not ep.dynamic and len(ep.error):
@@ -65,7 +60,7 @@ def score_episode(ep: Trace, hold_s: float = HOLD_S) -> EpisodeScore:
             and (
                 ep.verdict
                 if ep.verdict is not None
-                else len(abs_err) >= hold and (tail.mean() if ep.gusty else tail.max()) <= tolerance
+                else held(ep.error, ep.tolerance, ep.dynamic, ep.dt, ep.gusty, hold_s)
             )
         ),
         time_to_target_s=float((reached[0] + 1) * ep.dt) if len(reached) else math.nan,

@@ -8,10 +8,12 @@ flies the same seeded cases of that one flight (``evaluation.runner``).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from gymfg_il.collectors.config import MANUAL_HZ
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.envs.options import FlightOptions
 from gymfg_il.errors import ConfigError
@@ -99,6 +101,8 @@ def plan(cfg: EvalConfig) -> tuple[FlightSpec, dict[str, AgentSpec], list[str]]:
     """What flies (the flight, the agents by row name) and the notes on options that changed
     a policy's own flight; a clear error for a policy that cannot fly it."""
     metas = {path: policy_meta(path) for path in cfg.policy}
+    if cfg.pilot == "synthetic" and not cfg.policy and cfg.agent_hz is None:
+        cfg = dataclasses.replace(cfg, agent_hz=MANUAL_HZ)  # the pilot flies as a person does
     flight, notes = flight_for(metas, cfg)
     env = flight.make_env()
     try:

@@ -62,7 +62,7 @@ class ManualController:
         mouse: MouseBindings | None = None,
         joystick: JoystickBindings | None = None,
         throttle: float = 0.7,
-        window_size: tuple[int, int] = (900, 600),
+        window_size: tuple[int, int] = (900, 700),
         flightgear: FlightGearBindings | None = None,
     ) -> None:
         if device not in DEVICES:

@@ -1,11 +1,13 @@
 """A synthetic human pilot: a model of a person flying through the real ManualController.
 
 It decides, frame by frame, the pygame events a person at the controls would produce: keys
-pressed and released, joystick axes moved, the mouse dragged. What it wants to do comes from
-the task's autopilot (its "intent": a competent pilot knows what the aircraft needs); how it
-gets there is human:
+pressed and released, joystick axes moved, the mouse dragged. It sees only what the window
+draws (the display model, ``display.readings``); what it wants to do with that comes from the
+task's expert loops fed with those readings (its "intent", ``manual.perception``: a competent
+pilot knows what the aircraft needs); how it gets there is human:
 
-- it reacts to what it saw ``reaction_s`` ago, and reads the instruments imprecisely;
+- it reacts to what it saw ``reaction_s`` ago, and reads the instruments imprecisely (its
+  misreadings drift over about a second);
 - on the keyboard it can only hold keys: it presses one when the stick is off what it wants by
   more than its ``deadband``, and lets go only once the stick has passed the mark by its
   ``overshoot`` (over-corrections), while the controller's centring pulls the stick back;
@@ -24,12 +26,13 @@ from __future__ import annotations
 
 import collections
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from gymfg_il.agent import Agent
+from gymfg_il.display.readings import Display
 from gymfg_il.errors import ConfigError
 from gymfg_il.manual.bindings import (
     JoystickBindings,
@@ -38,9 +41,12 @@ from gymfg_il.manual.bindings import (
     deflection,
 )
 from gymfg_il.manual.controller import DEVICES, ManualController
+from gymfg_il.manual.perception import DisplayIntent
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW
+from gymfg_il.units import wrap_180
 
 CONTROLS = ("aileron", "elevator", "rudder", "throttle")
+MISREAD_S = 1.0  # how long a reading error lasts (the time constant of its drift)
 
 
 @dataclass(frozen=True)
@@ -106,7 +112,8 @@ class SyntheticPilot:
 
     Args:
         device: keyboard, joystick or mouse.
-        intent: what the pilot wants the controls to be (the task's autopilot).
+        intent: what the pilot wants the controls to be, from what the window shows
+            (``manual.perception.DisplayIntent``).
         dt: seconds per frame.
         skill: ``Skill`` or a level in [0, 1].
         keyboard, mouse, joystick: the session's bindings (which keys, axes, spans).
@@ -117,13 +124,13 @@ class SyntheticPilot:
     def __init__(
         self,
         device: str,
-        intent: Agent,
+        intent: DisplayIntent,
         dt: float,
         skill: Skill | float = 0.7,
         keyboard: KeyboardBindings | None = None,
         mouse: MouseBindings | None = None,
         joystick: JoystickBindings | None = None,
-        window_size: tuple[int, int] = (900, 600),
+        window_size: tuple[int, int] = (900, 700),
         seed: int = 0,
     ) -> None:
         if device not in DEVICES:
@@ -159,19 +166,29 @@ class SyntheticPilot:
         self._pointer: tuple[int, int] | None = None
         self._lapse_left = 0.0
         self._last_obs: np.ndarray | None = None
+        self._misread: np.ndarray | None = None  # each reading's error, in its own stds
         self._plugged = False
         self.neutral: np.ndarray = np.zeros(3)  # the stick's neutral (start_from moves it)
         self.sent: list[Any] = []
         self.pressed: list[tuple[str, bool]] = []  # (key, down) this frame, for the record
 
     # -- deciding --------------------------------------------------------------------------
-    def _perceive(self, observation: np.ndarray) -> np.ndarray:
-        """What the pilot reads off the instruments, ``reaction_s`` late and imprecisely."""
-        obs = np.asarray(observation, dtype=np.float64)
+    def _perceive(self, display: Display) -> np.ndarray:
+        """What the pilot reads off the window, ``reaction_s`` late and imprecisely."""
+        read = self.intent.look(display)
+        obs = read
+        if self._misread is None:
+            self._misread = np.zeros(len(read))
         if self.skill.perception and self._last_obs is not None:
-            change = np.abs(obs - self._last_obs) / self.dt  # how lively each reading is
-            obs = obs + self.rng.normal(0.0, 1.0, len(obs)) * self.skill.perception * change
-        self._last_obs = np.asarray(observation, dtype=np.float64)
+            change = read - self._last_obs
+            change[self.intent.angular] = wrap_180(change[self.intent.angular])
+            change = np.abs(change) / self.dt  # how lively each reading is
+            # a misjudgement drifts over about a second, it does not flicker frame by frame
+            keep = np.exp(-self.dt / MISREAD_S)
+            fresh = self.rng.normal(0.0, 1.0, len(read)) * np.sqrt(1.0 - keep * keep)
+            self._misread = keep * self._misread + fresh
+            obs = read + self._misread * self.skill.perception * change
+        self._last_obs = read
         self._seen.append(obs)
         return self._seen[0]
 
@@ -193,12 +210,12 @@ class SyntheticPilot:
         if start is not None:
             start(action)
 
-    def events(self, observation: np.ndarray, stick: np.ndarray) -> list[Any]:
-        """This frame's events, from the observation and the controls as they stand (also
-        kept as ``sent``; the keys among them as ``pressed``: (name, down)). The mouse and
-        the joystick aim at the wanted controls less the stick's neutral."""
+    def events(self, display: Display, stick: np.ndarray) -> list[Any]:
+        """This frame's events, from what the window shows and the controls as they stand
+        (also kept as ``sent``; the keys among them as ``pressed``: (name, down)). The mouse
+        and the joystick aim at the wanted controls less the stick's neutral."""
         self.pressed = []
-        seen = self._perceive(observation)
+        seen = self._perceive(display)
         want = np.clip(np.asarray(self.intent.act(seen), dtype=np.float64), ACTION_LOW, ACTION_HIGH)
         out: list[Any] = []
         if self.device == "joystick" and not self._plugged:
@@ -276,10 +293,13 @@ class SyntheticPilot:
 
 class PilotAgent:
     """A synthetic pilot flying as an Agent: its events go straight to a ManualController,
-    whose controls are the action (what ``eval --pilot synthetic`` flies)."""
+    whose controls are the action (what ``eval --pilot synthetic`` flies). ``look`` gives
+    the display of the moment; the observation an Agent is handed is never read."""
 
-    def __init__(self, pilot: SyntheticPilot, human: ManualController) -> None:
-        self.pilot, self.human = pilot, human
+    def __init__(
+        self, pilot: SyntheticPilot, human: ManualController, look: Callable[[], Display]
+    ) -> None:
+        self.pilot, self.human, self.look = pilot, human, look
 
     def reset(self, seed: int | None = None) -> None:
         self.human.reset(seed)
@@ -290,6 +310,6 @@ class PilotAgent:
         self.pilot.start_from(action)
 
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
-        events = self.pilot.events(observation, self.human.values)
+        events = self.pilot.events(self.look(), self.human.values)
         self.human.handle(events, self.pilot.dt)
         return self.human.act(observation)

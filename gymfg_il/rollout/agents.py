@@ -68,17 +68,21 @@ class AgentSpec:
         if self.kind in ("controller", "synthetic"):
             from gymfg_il.controllers.autopilot import controller_for
 
-            pilot = controller_for(
-                env.task, env.aircraft.model, env.dt, env.aircraft.profile.cruise_throttle
-            )
+            model, throttle = env.aircraft.model, env.aircraft.profile.cruise_throttle
             if self.kind == "controller":
-                return pilot
+                return controller_for(env.task, model, env.dt, throttle)
+            from gymfg_il.display.readings import display_of
             from gymfg_il.manual.controller import ManualController
+            from gymfg_il.manual.perception import DisplayIntent
             from gymfg_il.manual.synthetic import PilotAgent, SyntheticPilot
 
-            throttle = env.aircraft.profile.cruise_throttle
+            intent = DisplayIntent(env.task, model, env.dt, throttle)
+            pilot = SyntheticPilot(self.device, intent, env.dt, self.skill)
             human = ManualController(self.device, throttle=throttle)
-            return PilotAgent(SyntheticPilot(self.device, pilot, env.dt, self.skill), human)
+            world = env.world
+            return PilotAgent(
+                pilot, human, lambda: display_of(env.task, world.slots[0].state, world.steps)
+            )
         from gymfg_il.policies.agent import PolicyAgent
         from gymfg_il.policies.lerobot_checkpoint import LeRobotAgent, find_pretrained
 

@@ -77,8 +77,8 @@ def test_keyboard_rates_and_centring_reach_the_dataset(tmp_path):
 
 def test_mouse_is_the_stick(tmp_path):
     move = pygame.event.Event(
-        pygame.MOUSEMOTION, pos=(625 + 100, 300 - 50), rel=(0, 0), buttons=(0, 0, 0)
-    )  # the window (1,250 x 600 with the pilot's view) centres the stick
+        pygame.MOUSEMOTION, pos=(625 + 100, 350 - 50), rel=(0, 0), buttons=(0, 0, 0)
+    )  # the window (1,250 x 700 with the pilot's view) centres the stick
     script = {1: [lambda: key(pygame.K_SPACE)], 5: [move], 200: [lambda: key(pygame.K_q)]}
     run(tmp_path, script, device="mouse")
     frames = load_frames(tmp_path / "dataset")
@@ -178,8 +178,26 @@ def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
 
     ManualSession(manual_config(tmp_path), on_frame, realtime=False).run(max_frames=40)
     flying = [f for f in drawn if f.status != "idle"]
-    assert flying and all(f.target_name == "altitude_ft (ft)" for f in flying)
-    assert all(abs(f.target - f.actual) <= 1000 for f in flying)
+    assert flying and all("altitude_ft_target" in f.display.names for f in flying)
+    assert all(
+        abs(f.display["altitude_ft_target"] - f.display["altitude_ft"]) <= 1000 for f in flying
+    )
+    idle = [f for f in drawn if f.status == "idle"]
+    assert idle and "altitude_ft_target" not in idle[0].display.names  # no target before
+    assert any("Success" in line for line in idle[0].notes)  # the briefing, before it
+
+
+def test_the_window_says_how_an_episode_went(tmp_path):
+    def on_frame(frame, session):
+        if frame == 1:
+            key(pygame.K_SPACE)
+        if frame == 100:
+            key(pygame.K_q)
+
+    session = ManualSession(manual_config(tmp_path, episode_time_s=2), on_frame, realtime=False)
+    session.run(max_frames=120)
+    assert session.debrief is not None and not session.debrief.success  # 2 s: not held yet
+    assert session.debrief.lines[0].startswith("FAILED: over the last 10 s")
 
 
 def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
@@ -196,7 +214,7 @@ def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
             key(pygame.K_q)
 
     session = ManualSession(manual_config(tmp_path), on_frame, realtime=False)
-    assert session.gui.size == (1250, 600) and session.camera is not None
+    assert session.gui.size == (1250, 700) and session.camera is not None
     session.run(max_frames=40)
     # the view's box right of the instruments: sky on top (blue), ground below (green)
     for shot in shots.values():
@@ -207,7 +225,7 @@ def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
     headless = ManualSession(
         manual_config(tmp_path / "b", pilot_view="none"), driven, realtime=False
     )
-    assert headless.gui.size == (900, 600) and headless.camera is None
+    assert headless.gui.size == (900, 700) and headless.camera is None
 
 
 def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):

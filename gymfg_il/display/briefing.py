@@ -1,0 +1,105 @@
+"""What the window says before and after an episode.
+
+The briefing states the task in words: its goal (the first paragraph of the task's
+docstring), what counts as success (the docstring's ``Success:`` sentence, or the target
+rule of ``tasks.verdicts``) and the time. Nothing is written twice: change a task's docstring
+and the briefing follows.
+
+The debrief gives the task's verdict on the flown states (``ManeuverTask.judge``, or the
+target rule), why it ended, the return and the main error.
+"""
+
+from __future__ import annotations
+
+import inspect
+import re
+import textwrap
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.sim.properties import BY_NAME
+from gymfg_il.tasks.verdicts import HOLD_S, allowed_error, held
+
+WIDTH = 84  # characters per line of the window's text panel
+
+
+def _wrap(text: str) -> list[str]:
+    return textwrap.wrap(" ".join(text.split()), WIDTH)
+
+
+def _success(task: Any) -> str:
+    doc = inspect.getdoc(type(task)) or ""
+    found = re.search(r"Success:\s*(.*?)(?:\n\s*\n|\n\s*Start|\Z)", doc, re.S)
+    if found:
+        return found.group(1).strip()
+    tracked = task.tracked()
+    if tracked:
+        variable = BY_NAME[tracked["variable"]]
+        tolerance = allowed_error(tracked["tolerance"], tracked["dynamic"])
+        return (
+            f"{variable.description} within {tolerance:g} {variable.unit} of the target over "
+            f"the last {HOLD_S:g} s, without crashing or stalling."
+        )
+    return "fly the whole episode without crashing or stalling."
+
+
+def briefing(task: Any, episode_time_s: float) -> list[str]:
+    """The task in words: goal, success, time (a bound Task)."""
+    doc = inspect.getdoc(type(task)) or type(task).__name__
+    goal = doc.split("\n\n")[0]
+    lines = [f"TASK: {task.name}", *_wrap(goal), *_wrap("Success: " + _success(task))]
+    lines.append(f"Time: {episode_time_s:g} s. The targets are the magenta bugs; the panel guides.")
+    return lines
+
+
+@dataclass(frozen=True)
+class Debrief:
+    """The verdict of one flown episode, and the lines that say it."""
+
+    success: bool
+    detail: str
+    lines: tuple[str, ...]
+
+
+def debrief(
+    task: Any,
+    states: np.ndarray,
+    errors: np.ndarray,
+    dt: float,
+    ended: str,
+    total_return: float,
+    gusty: bool = False,
+) -> Debrief:
+    """Judge an episode as evaluation does: ``states`` (catalogue order, the reset state
+    first) for a maneuver's judge, ``errors`` (the tracked error entry of each step's
+    observation) for the target rule; ``ended`` says why it ended (``time limit``,
+    ``crashed``, ``ended by the pilot``)."""
+    terminated = ended not in ("time limit", "ended by the pilot")
+    judge = getattr(task, "judge", None)
+    if terminated:
+        success, detail = False, ended
+    elif judge is not None and getattr(task, "plan", None):
+        verdict = judge(task.plan, states, dt)
+        success, detail = verdict.success, verdict.detail
+    else:
+        success, detail = _held(task, errors, dt, gusty)
+    head = ("SUCCESS: " if success else "FAILED: ") + detail
+    lines = [*_wrap(head), f"ended: {ended}; return {total_return:.1f}; {len(errors)} steps"]
+    return Debrief(success, detail, tuple(lines))
+
+
+def _held(task: Any, errors: np.ndarray, dt: float, gusty: bool) -> tuple[bool, str]:
+    tracked = task.tracked()
+    if not tracked:
+        return True, "flown to the end"
+    if not len(errors):
+        return False, "no step flown"
+    ok = held(errors, tracked["tolerance"], tracked["dynamic"], dt, gusty)
+    last = np.abs(errors[-max(1, round(HOLD_S / dt)) :])
+    unit = BY_NAME[tracked["variable"]].unit
+    return ok, (
+        f"over the last {HOLD_S:g} s the error was {last.mean():.1f} {unit} on average, "
+        f"at most {last.max():.1f} {unit}"
+    )

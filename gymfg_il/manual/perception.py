@@ -1,0 +1,106 @@
+"""What a pilot who sees only the window wants the controls to be.
+
+A person at the collector's window has the display model (``display.readings``): the
+instruments, the targets as bugs and the task's guidance, nothing else; no observation
+vector, no integral, no body rate. ``DisplayIntent`` is the intent of the synthetic pilot:
+the task's expert loops (``controllers.autopilot``), fed only with readings the window draws,
+and with the two rates a person reads from the moving attitude indicator (how fast the
+horizon rolls and pitches). Each task's targets are taken from its bugs and guidance
+(``DISPLAY_SOURCES``); a reading the window does not draw cannot be read: building the
+intent for a task fails if its loops need one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.controllers.autopilot import Autopilot, controller_for
+from gymfg_il.display.guidance import reading_names
+from gymfg_il.display.readings import Display
+from gymfg_il.units import DEG_TO_RAD, wrap_180
+
+# the rates the eye reads off the attitude indicator's motion: rate -> the reading it moves
+MOTION = {"p_rad_s": "roll_deg", "q_rad_s": "pitch_deg"}
+ANGLES = {"heading_deg", "heading_deg_target", "gate_bearing_deg", "lead_heading_deg"}
+ANGLES |= {"runway_course_deg", "roll_deg"}
+_NONE: frozenset[str] = frozenset()
+# where each task's loops take their targets from on the display (the expert's other settings
+# and gains stay); a target task's bug is named as the expert's source already
+DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
+    "turn": {
+        "vertical_source": "altitude_ft_target",
+        "lateral_source": "turn_remaining_deg",
+        "relative": frozenset({"lateral"}),
+    },
+    "waypoints": {
+        "vertical_source": "gate_altitude_ft",
+        "lateral_source": "gate_bearing_deg",
+        "relative": _NONE,
+    },
+    "formation": {"lateral_source": "lead_heading_deg", "relative": frozenset({"vertical"})},
+    "approach": {
+        "lateral_source": "runway_course_deg",
+        "speed_source": "approach_kts",
+        "relative": frozenset({"vertical"}),
+    },
+    "level": {
+        "vertical_source": "altitude_ft_target",
+        "lateral_source": "heading_deg_target",
+        "relative": _NONE,
+    },
+}
+
+
+class DisplayIntent:
+    """The controls a pilot looking at ``task``'s window wants (module docstring).
+
+    Args:
+        task: the bound Task being flown.
+        model: the aircraft's JSBSim model (its gain set).
+        dt: seconds per agent step.
+        throttle: the aircraft's cruise throttle.
+
+    ``look(display)`` turns one frame's display into what the pilot reads (``names``, in
+    order: the readings, then the rates of ``MOTION``); ``act(seen)`` gives the controls.
+    """
+
+    def __init__(self, task: Any, model: str, dt: float, throttle: float) -> None:
+        expert = controller_for(task, model, dt, throttle)
+        sources = DISPLAY_SOURCES.get(str(getattr(task, "name", "")), {})
+        targets = dataclasses.replace(expert.targets, **sources)
+        self.readings = reading_names(task)
+        self.names = (*self.readings, *MOTION)
+        self.angular = np.array([n in ANGLES for n in self.names])
+        self.dt = dt
+        self.autopilot = Autopilot(self.names, model, dt, targets, gains=expert.gains)
+        self.autopilot.set_throttle_trim(throttle)
+        self._last: dict[str, float] | None = None
+
+    @property
+    def used(self) -> set[str]:
+        """The display's readings the loops read (the rates count as their attitude's)."""
+        names = set(self.autopilot.needs)
+        return {MOTION.get(n, n) for n in names}
+
+    def reset(self, seed: int | None = None) -> None:
+        self.autopilot.reset(seed)
+        self._last = None
+
+    def start_from(self, action: np.ndarray) -> None:
+        self.autopilot.start_from(action)
+
+    def look(self, display: Display) -> np.ndarray:
+        """What the pilot reads off one frame (``names`` order)."""
+        shown = {r.name: r.value for r in display}
+        values = [shown[name] for name in self.readings]
+        last, self._last = self._last, shown
+        for angle in MOTION.values():
+            moved = 0.0 if last is None else wrap_180(shown[angle] - last[angle])
+            values.append(moved / self.dt * DEG_TO_RAD)
+        return np.array(values, dtype=np.float64)
+
+    def act(self, seen: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        return self.autopilot.act(seen)
