@@ -5,11 +5,13 @@ beside them, the pilot's camera."""
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING
 
+from gymfg_il.display.readings import Display
 from gymfg_il.manual.gui import GuiFrame
 from gymfg_il.sim.properties import BY_NAME, INDEX
-from gymfg_il.tasks.scenery import landmarks_of
+from gymfg_il.tasks.scenery import Landmark, landmarks_of
 
 if TYPE_CHECKING:
     from gymfg_il.collectors.manual import ManualSession
@@ -38,7 +40,7 @@ def window_frame(session: ManualSession) -> GuiFrame:
     view = None
     if session.camera is not None:
         marks = landmarks_of(env.task, getattr(env.task, "plan", None), world.steps)
-        view = session.camera.frame(state, marks)
+        view = session.camera.frame(state, next_gate_marked(marks, session.display))
     if flying:
         notes = session.briefing[:2]
     elif session.debrief is not None:
@@ -59,3 +61,13 @@ def window_frame(session: ManualSession) -> GuiFrame:
         show_help=session.show_help,
         view=view,
     )
+
+
+def next_gate_marked(marks: list[Landmark], display: Display) -> list[Landmark]:
+    """``marks`` with the next gate to fly through highlighted (the display's gates left)."""
+    gates = [i for i, mark in enumerate(marks) if mark.kind == "gate"]
+    left = [r.value for r in display if r.name == "gates_left"]
+    if not gates or not left or not 0 < left[0] <= len(gates):
+        return marks
+    at = gates[len(gates) - round(left[0])]
+    return [dataclasses.replace(m, highlight=True) if i == at else m for i, m in enumerate(marks)]

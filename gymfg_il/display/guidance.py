@@ -73,10 +73,10 @@ WAYPOINTS = (
 )
 FORMATION = (
     Line("lead_heading_deg", "deg", "heading", "bug", "the lead's heading"),
-    Line("behind_slot_ft", "ft", "slot", "guidance", "behind the slot"),
-    Line("right_of_slot_ft", "ft", "slot", "guidance", "right of the slot"),
-    Line("below_slot_ft", "ft", "slot", "guidance", "below the slot"),
-    Line("behind_slot_rate_fps", "ft/s", "slot", "guidance", "falling back at"),
+    Line("behind_slot_ft", "ft", "slot", "guidance", "off the slot, along"),
+    Line("right_of_slot_ft", "ft", "slot", "guidance", "off the slot, across"),
+    Line("below_slot_ft", "ft", "slot", "guidance", "off the slot, height"),
+    Line("behind_slot_rate_fps", "ft/s", "slot", "guidance", "closure"),
 )
 APPROACH = (
     Line("runway_course_deg", "deg", "heading", "bug", "runway course"),
@@ -84,9 +84,9 @@ APPROACH = (
     Line("localizer_dots", "dot", "localizer", "needle", "localizer (right of the centre line)"),
     Line("glideslope_dots", "dot", "glideslope", "needle", "glide slope (below the path)"),
     Line("distance_ft", "ft", "panel", "guidance", "to the threshold"),
-    Line("centerline_offset_ft", "ft", "panel", "guidance", "right of the centre line"),
-    Line("glidepath_error_ft", "ft", "panel", "guidance", "below the glide path"),
-    Line("height_above_threshold_ft", "ft", "panel", "guidance", "above the threshold"),
+    Line("centerline_offset_ft", "ft", "panel", "guidance", "off the centre line"),
+    Line("glidepath_error_ft", "ft", "panel", "guidance", "off the glide path"),
+    Line("height_above_threshold_ft", "ft", "panel", "guidance", "height above the threshold"),
 )
 
 

@@ -117,3 +117,12 @@ def test_the_briefing_is_the_tasks_docstring_and_the_debrief_its_verdict(make_en
 
 def test_every_library_task_is_checked_here():
     assert set(EVERY_TASK) == set(TASK_FAMILIES)
+
+
+def test_the_next_gate_is_highlighted_in_the_view(make_env):
+    from gymfg_il.collectors.manual_view import next_gate_marked
+    from gymfg_il.tasks.scenery import landmarks_of
+
+    env, display = started(make_env, "waypoints")
+    marks = next_gate_marked(landmarks_of(env.task, env.task.plan, 0), display)
+    assert [m.highlight for m in marks] == [True, False, False]  # 3 gates left: the first
