@@ -104,6 +104,7 @@ class Autopilot:
         for source in (targets.vertical_source, targets.lateral_source, targets.speed_source):
             if isinstance(source, str):
                 need.append(source)
+        self.needs = tuple(dict.fromkeys(need))  # the entries it reads, in order
         missing = [n for n in need if n not in self.index]
         if missing:
             raise ConfigError(f"the observation lacks {missing} that the autopilot reads")

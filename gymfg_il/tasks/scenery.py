@@ -31,6 +31,9 @@ class Landmark:
         heading_deg, roll_deg, pitch_deg: its orientation.
         width_ft, length_ft: runway width and length; gate width and height; aircraft
             span and length.
+        highlight: draw it as the one that matters now (the next gate: a camera in legible
+            mode paints it in its own colour with a thicker frame; the default mode, which
+            makes dataset images, ignores it).
     """
 
     kind: str
@@ -42,6 +45,7 @@ class Landmark:
     pitch_deg: float = 0.0
     width_ft: float = 36.0
     length_ft: float = 27.0
+    highlight: bool = False
 
 
 def aircraft_landmark(state: np.ndarray, span_ft: float = 36.0) -> Landmark:
