@@ -14,13 +14,17 @@ with an offscreen moderngl context is measured by ``benchmarks/camera.py`` (docs
 Views: ``front`` (the pilot's eye, 90 deg horizontal field of view, rolled and pitched with
 the aircraft) and ``chase`` (behind and above, turned with the heading and pitch but not the
 roll, with the aircraft drawn, so its bank shows).
+
+Landmarks are drawn at their true size (``viz.shapes``); a window a person flies by asks for
+the legible mode (``legible=True``, ``viz.legible``), which draws what a task needs seen no
+smaller than a person can see it: a runway with its lights from miles out, the next gate
+highlighted, another aircraft's bank.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
 
 import numpy as np
 
@@ -28,17 +32,16 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.scenery import Landmark
 from gymfg_il.units import FT_PER_DEG, wrap_180
+from gymfg_il.viz import legible as _legible
+from gymfg_il.viz.shapes import COLOURS, MARKING, NEAR_FT, quads, rotation
+
+__all__ = ["VIEWS", "Camera", "rotation"]
 
 VIEWS = ("front", "chase")
 _SKY_HORIZON = np.array([200, 222, 240], dtype=np.float32)
 _SKY_ZENITH = np.array([60, 110, 190], dtype=np.float32)
 _HAZE = np.array([190, 205, 215], dtype=np.float32)
 _GROUND = np.array([[96, 128, 64], [120, 148, 78], [110, 112, 70], [136, 134, 88]], np.float32)
-_COLOURS = {
-    "runway": (70, 70, 74),
-    "gate": (235, 110, 20),
-    "aircraft": (230, 40, 40),
-}
 _HAZE_LEVELS, _SKY_LEVELS = 64, 32
 _HAZE_SPAN_FT = 120000.0  # ground farther than this is all haze
 _HAZE_FT = 30000.0  # distance at which the ground is 63 % haze
@@ -62,39 +65,7 @@ _PALETTE = _palette()
 # 3 bytes
 _PALETTE_RGBA = np.concatenate([_PALETTE, np.full((len(_PALETTE), 1), 255, np.uint8)], 1)
 _PALETTE_RGBA = _PALETTE_RGBA.view(np.uint32).ravel()
-# wing, fuselage seen from above and from the side, tailplane, fin
-_AIRCRAFT = np.array(
-    [
-        [(0.0, -1, 0), (0.3, -1, 0), (0.3, 1, 0), (0.0, 1, 0)],
-        [(0.6, -0.1, 0), (0.6, 0.1, 0), (-0.4, 0.05, 0), (-0.4, -0.05, 0)],
-        [(0.6, 0, -0.06), (0.6, 0, 0.06), (-0.4, 0, 0.03), (-0.4, 0, -0.03)],
-        [(-0.3, -0.35, 0), (-0.4, -0.35, 0), (-0.4, 0.35, 0), (-0.3, 0.35, 0)],
-        [(-0.28, 0, 0), (-0.4, 0, 0), (-0.42, 0, -0.2), (-0.36, 0, -0.2)],
-    ]
-)
-_MARKING = (235, 235, 235)
-_NEAR_FT = 1.0
 _CHASE_FT = (90.0, 0.0, -30.0)  # camera behind, right, below (negative: above) the aircraft
-
-
-def rotation(roll_deg: float, pitch_deg: float, heading_deg: float) -> np.ndarray:
-    """Body (forward, right, down) to local (north, east, down) rotation matrix."""
-    r, p, h = (math.radians(a) for a in (roll_deg, pitch_deg, heading_deg))
-    cr, sr, cp, sp, ch, sh = (
-        math.cos(r),
-        math.sin(r),
-        math.cos(p),
-        math.sin(p),
-        math.cos(h),
-        math.sin(h),
-    )
-    return np.array(
-        [
-            [cp * ch, sr * sp * ch - cr * sh, cr * sp * ch + sr * sh],
-            [cp * sh, sr * sp * sh + cr * ch, cr * sp * sh - sr * ch],
-            [-sp, sr * cp, cr * cp],
-        ]
-    )
 
 
 class Camera:
@@ -104,10 +75,19 @@ class Camera:
         width, height: frame size in pixels.
         view: ``front`` or ``chase``.
         fov_deg: horizontal field of view (default 90 deg in front, 60 deg for the chase).
+        legible: draw landmarks for a person's eyes (``viz.legible``: a runway seen from
+            miles out, the highlighted next gate, another aircraft's bank) instead of at
+            their true size. Off (the default) for dataset images, which it would change.
     """
 
     def __init__(
-        self, width: int = 128, height: int = 128, view: str = "front", fov_deg: float | None = None
+        self,
+        width: int = 128,
+        height: int = 128,
+        view: str = "front",
+        fov_deg: float | None = None,
+        *,
+        legible: bool = False,
     ) -> None:
         fov_deg = fov_deg if fov_deg is not None else (90.0 if view == "front" else 60.0)
         if view not in VIEWS:
@@ -116,8 +96,9 @@ class Camera:
             raise ConfigError(f"camera size {width}x{height}: each side must be 8-4096 pixels")
         if not 10.0 <= fov_deg <= 150.0:
             raise ConfigError(f"fov_deg={fov_deg}: give a field of view of 10-150 degrees")
-        self.width, self.height, self.view = width, height, view
+        self.width, self.height, self.view, self.legible = width, height, view, legible
         self.focal = (width / 2.0) / math.tan(math.radians(fov_deg) / 2.0)
+        self.lens = _legible.Lens(self.focal, width / 2.0, height / 2.0)
         u = (np.arange(width, dtype=np.float32) + 0.5 - width / 2.0) / self.focal
         v = (np.arange(height, dtype=np.float32) + 0.5 - height / 2.0) / self.focal
         self._right, self._down = (a.ravel() for a in np.meshgrid(u, v))
@@ -208,6 +189,7 @@ class Camera:
         # (item's distance, layer, quad's distance) orders the painting: far items first, an
         # item's markings over its surface, its nearer faces over its farther ones
         polygons: list[tuple[tuple[float, int, float], np.ndarray, tuple[int, ...]]] = []
+        paints: list[_legible.Paint] = []
         world_to_cam = rot.T
         for item in items:
             offset = (
@@ -220,11 +202,14 @@ class Camera:
                 )
                 - eye
             )
-            colour = _COLOURS.get(item.kind, (255, 0, 255))
+            if self.legible:
+                paints += _legible.paints(item, offset, world_to_cam, self.lens)
+                continue
+            colour = COLOURS.get(item.kind, (255, 0, 255))
             depth = float((offset @ world_to_cam.T)[0])
-            for k, (quad, layer) in enumerate(_shape(item)):
+            for k, (quad, layer) in enumerate(quads(item)):
                 cam = (quad + offset) @ world_to_cam.T  # (forward, right, down)
-                if np.any(cam[:, 0] < _NEAR_FT):
+                if np.any(cam[:, 0] < NEAR_FT):
                     continue
                 px = np.stack(
                     [
@@ -233,10 +218,26 @@ class Camera:
                     ],
                     axis=1,
                 )
-                tint = _MARKING if layer else tuple(int(c * (1.0 - 0.12 * (k % 2))) for c in colour)
+                tint = MARKING if layer else tuple(int(c * (1.0 - 0.12 * (k % 2))) for c in colour)
                 polygons.append(((-depth, layer, -float(cam[:, 0].mean())), px, tint))
         for _, px, tint in sorted(polygons, key=lambda p: p[0]):
             self._fill(image, px, tint)  # type: ignore[arg-type]
+        for paint in sorted(paints, key=lambda p: p.order):
+            if paint.light_px:
+                for at in paint.pixels:
+                    self._light(image, at, paint.light_px, paint.colour)
+            else:
+                self._fill(image, paint.pixels, paint.colour)
+
+    def _light(
+        self, image: np.ndarray, at: np.ndarray, side: int, colour: tuple[int, int, int]
+    ) -> None:
+        """A square light ``side`` pixels wide centred on ``at`` (x, y pixels)."""
+        left, top = math.floor(at[0] - side / 2.0 + 0.5), math.floor(at[1] - side / 2.0 + 0.5)
+        x0, x1 = max(0, left), min(self.width, left + side)
+        y0, y1 = max(0, top), min(self.height, top + side)
+        if x0 < x1 and y0 < y1:
+            image[y0:y1, x0:x1] = colour
 
     def _fill(self, image: np.ndarray, px: np.ndarray, colour: tuple[int, int, int]) -> None:
         """Fill the convex polygon with vertices ``px`` (x, y pixels, either winding)."""
@@ -253,45 +254,3 @@ class Camera:
             inside_pos &= cross >= 0
             inside_neg &= cross <= 0
         image[y0:y1, x0:x1][inside_pos | inside_neg] = colour
-
-
-def _shape(item: Landmark) -> list[tuple[np.ndarray, int]]:
-    """Quads (4 x 3 points, north-east-down ft, about the item's position) that draw it, each
-    with its layer: 0 the surface, 1 a white marking painted on it."""
-    rot = rotation(item.roll_deg, item.pitch_deg, item.heading_deg)
-    w, length = item.width_ft, item.length_ft
-    body: list[Any]
-    marks: list[Any] = []
-    if item.kind == "runway":
-        body = [
-            [(0.0, -w / 2, 0.0), (length, -w / 2, 0.0), (length, w / 2, 0.0), (0.0, w / 2, 0.0)]
-        ]
-        # threshold bar, then the centre line's dashes
-        marks = [
-            [
-                (20.0, -0.45 * w, 0.0),
-                (80.0, -0.45 * w, 0.0),
-                (80.0, 0.45 * w, 0.0),
-                (20.0, 0.45 * w, 0.0),
-            ]
-        ]
-        for x in np.arange(200.0, length - 150.0, 400.0):
-            c = 0.03 * w
-            marks.append([(x, -c, 0.0), (x + 150.0, -c, 0.0), (x + 150.0, c, 0.0), (x, c, 0.0)])
-    elif item.kind == "gate":
-        bar = max(w, length) * 0.06
-        hw, hh = w / 2, length / 2
-        body = [
-            [(0, -hw, -hh), (0, hw, -hh), (0, hw, -hh + bar), (0, -hw, -hh + bar)],
-            [(0, -hw, hh - bar), (0, hw, hh - bar), (0, hw, hh), (0, -hw, hh)],
-            [(0, -hw, -hh), (0, -hw + bar, -hh), (0, -hw + bar, hh), (0, -hw, hh)],
-            [(0, hw - bar, -hh), (0, hw, -hh), (0, hw, hh), (0, hw - bar, hh)],
-        ]
-    else:  # aircraft: the model's corners in (length, span, length) units
-        scale = np.array([length, w / 2, length])
-        body = [q * scale for q in _AIRCRAFT]
-    return [
-        (np.asarray(q, dtype=np.float64) @ rot.T, layer)
-        for layer, quads in ((0, body), (1, marks))
-        for q in quads
-    ]

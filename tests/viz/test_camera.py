@@ -1,3 +1,5 @@
+import dataclasses
+import hashlib
 import math
 
 import numpy as np
@@ -94,3 +96,32 @@ def test_bad_camera_settings_are_clear_errors():
         Camera(view="cockpit")
     with pytest.raises(ConfigError, match="pixels"):
         Camera(4, 4)
+
+
+def _scene():
+    """A runway, a gate and another aircraft in one front view, banked and pitched."""
+    ft = math.pi / 180.0 * 20902230.97  # ft per degree of latitude
+    marks = [
+        Landmark("runway", 37.6 + 6000 / ft, -122.4 + 300 / ft, 0.0, 15.0, 0.0, 0.0, 150.0, 5000.0),
+        Landmark("gate", 37.6 + 2500 / ft, -122.4 - 400 / ft, 1400.0, 5.0, 0.0, 0.0, 600.0, 300.0),
+        Landmark("aircraft", 37.6 + 400 / ft, -122.4 - 150 / ft, 1480.0, 12.0, 20.0, 3.0),
+    ]
+    return state(roll=8.0, pitch=-2.0, heading=10.0, alt=1500.0, agl=1500.0), marks
+
+
+@pytest.mark.parametrize(
+    ("view", "size", "digest"),
+    [
+        ("front", 128, "cc8446074011be07"),
+        ("front", 320, "adb3f64c4b461a3b"),
+        ("chase", 128, "241dcd562dcb2953"),
+    ],
+)
+def test_the_default_frames_are_the_ones_datasets_were_made_with(view, size, digest):
+    # hashes taken before the legible mode existed: dataset images must not change
+    own, marks = _scene()
+    frame = Camera(size, size, view=view).frame(own, marks)
+    assert hashlib.sha256(frame.tobytes()).hexdigest()[:16] == digest
+    # the default mode ignores a highlight (it is the window's, not the dataset's)
+    lit = [dataclasses.replace(m, highlight=True) for m in marks]
+    assert np.array_equal(Camera(size, size, view=view).frame(own, lit), frame)
