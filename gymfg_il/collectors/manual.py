@@ -153,7 +153,9 @@ class ManualSession:
         self.help = help_lines(config.device, self.kb)
         title = f"GymFG-IL: {flight.task_label} on {self.env.aircraft.model}"
         pilot_view = None if config.pilot_view == "none" else config.pilot_view
-        self.camera = Camera(320, 320, view=pilot_view) if pilot_view and self.draw else None
+        self.camera = (
+            Camera(320, 320, view=pilot_view, legible=True) if pilot_view and self.draw else None
+        )
         self.gui = ControlsGUI(size=(1250, 700) if self.camera else (900, 700), title=title)
         self.human.window_size = self.gui.size
         self.stats = SessionStats()
