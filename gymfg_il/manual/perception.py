@@ -3,11 +3,11 @@
 A person at the collector's window has the display model (``display.readings``): the
 instruments, the targets as bugs and the task's guidance, nothing else; no observation
 vector, no integral, no body rate. ``DisplayIntent`` is the intent of the synthetic pilot:
-the task's expert loops (``controllers.autopilot``), fed only with readings the window draws,
-and with the two rates a person reads from the moving attitude indicator (how fast the
-horizon rolls and pitches). Each task's targets are taken from its bugs and guidance
-(``DISPLAY_SOURCES``); a reading the window does not draw cannot be read: building the
-intent for a task fails if its loops need one.
+the task's expert loops (``controllers.autopilot``, flown with a person's hands:
+``hands_of``), fed only with readings the window draws, and with the two rates a person reads
+from the moving attitude indicator (how fast the horizon rolls and pitches). Each task's
+targets are taken from its bugs and guidance (``DISPLAY_SOURCES``); a reading the window does
+not draw cannot be read: building the intent for a task fails if its loops need one.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.controllers.autopilot import Autopilot, controller_for
+from gymfg_il.controllers.gains import Gains
 from gymfg_il.display.guidance import reading_names
 from gymfg_il.display.readings import Display
 from gymfg_il.units import DEG_TO_RAD, wrap_180
@@ -27,6 +28,8 @@ MOTION = {"p_rad_s": "roll_deg", "q_rad_s": "pitch_deg"}
 ANGLES = {"heading_deg", "heading_deg_target", "gate_bearing_deg", "lead_heading_deg"}
 ANGLES |= {"runway_course_deg", "roll_deg"}
 _NONE: frozenset[str] = frozenset()
+PITCH_DAMPING = 0.5  # of the expert's pitch-rate gain
+SLIP_GAIN = 0.4  # of the expert's slip gains (the integral's half of that)
 # where each task's loops take their targets from on the display (the expert's other settings
 # and gains stay); a target task's bug is named as the expert's source already
 DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
@@ -54,6 +57,18 @@ DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
 }
 
 
+def hands_of(gains: Gains) -> Gains:
+    """The expert's gains as a person's hands fly them: less pitch damping (a person reads the
+    pitch rate off the moving horizon, late and imprecisely, where an autopilot has a rate
+    gyro) and a gentler rudder on a slip (keyboard taps held against a P+I slip loop chatter
+    past the tolerance)."""
+    kp, ki, kd = gains.pitch
+    skp, ski, skd = gains.slip
+    return dataclasses.replace(
+        gains, pitch=(kp, ki, kd * PITCH_DAMPING), slip=(skp * SLIP_GAIN, ski * SLIP_GAIN / 2, skd)
+    )
+
+
 class DisplayIntent:
     """The controls a pilot looking at ``task``'s window wants (module docstring).
 
@@ -75,7 +90,8 @@ class DisplayIntent:
         self.names = (*self.readings, *MOTION)
         self.angular = np.array([n in ANGLES for n in self.names])
         self.dt = dt
-        self.autopilot = Autopilot(self.names, model, dt, targets, gains=expert.gains)
+        gains = hands_of(expert.gains)
+        self.autopilot = Autopilot(self.names, model, dt, targets, gains=gains)
         self.autopilot.set_throttle_trim(throttle)
         self._last: dict[str, float] | None = None
 
