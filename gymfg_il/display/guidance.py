@@ -8,7 +8,7 @@ pilot expects for it (``display.readings`` says what a reading is).
 - climb-turn: the new altitude and heading as bugs;
 - waypoints: the next gate's bearing and height as bugs, its distance, the gates left and
   the turn at it;
-- formation: the lead's heading as a bug; the slot's offset (behind/ahead, right/left,
+- formation: the lead's heading and bank as bugs; the slot's offset (behind/ahead, right/left,
   below/above) and the closure rate, in words and on a diagram;
 - approach: the runway course and the approach speed as bugs; localizer and glide-slope
   needles in dots; the distance to the threshold, the offsets in ft, the height above the
@@ -73,6 +73,7 @@ WAYPOINTS = (
 )
 FORMATION = (
     Line("lead_heading_deg", "deg", "heading", "bug", "the lead's heading"),
+    Line("lead_roll_deg", "deg", "bank", "bug", "the lead's bank"),
     Line("behind_slot_ft", "ft", "slot", "guidance", "off the slot, along"),
     Line("right_of_slot_ft", "ft", "slot", "guidance", "off the slot, across"),
     Line("below_slot_ft", "ft", "slot", "guidance", "off the slot, height"),
@@ -113,6 +114,7 @@ def _waypoints(task: Any, o: dict[str, float]) -> list[float]:
 def _formation(task: Any, o: dict[str, float]) -> list[float]:
     return [
         wrap_360(o["heading_deg"] + o["lead_heading_error_deg"]),
+        o["lead_roll_deg"],
         o["behind_slot_ft"],
         o["right_of_slot_ft"],
         o["below_slot_ft"],

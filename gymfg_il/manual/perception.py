@@ -26,7 +26,7 @@ from gymfg_il.units import DEG_TO_RAD, wrap_180
 # the rates the eye reads off the attitude indicator's motion: rate -> the reading it moves
 MOTION = {"p_rad_s": "roll_deg", "q_rad_s": "pitch_deg"}
 ANGLES = {"heading_deg", "heading_deg_target", "gate_bearing_deg", "lead_heading_deg"}
-ANGLES |= {"runway_course_deg", "roll_deg"}
+ANGLES |= {"runway_course_deg", "roll_deg", "lead_roll_deg"}
 _NONE: frozenset[str] = frozenset()
 PITCH_DAMPING = 0.5  # of the expert's pitch-rate gain
 SLIP_GAIN = 0.4  # of the expert's slip gains (the integral's half of that)
@@ -43,7 +43,11 @@ DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
         "lateral_source": "gate_bearing_deg",
         "relative": _NONE,
     },
-    "formation": {"lateral_source": "lead_heading_deg", "relative": frozenset({"vertical"})},
+    "formation": {
+        "lateral_source": "lead_heading_deg",
+        "bank_source": "lead_roll_deg",
+        "relative": frozenset({"vertical"}),
+    },
     "approach": {
         "lateral_source": "runway_course_deg",
         "speed_source": "approach_kts",
