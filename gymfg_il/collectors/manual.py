@@ -148,7 +148,7 @@ class ManualSession:
             assistant = spec.make(self.env)
         self.pilot = Takeover(self.human, assistant)
         self.rollout = Rollout(self.env, [self.pilot])
-        person = "synthetic" if synthetic else "human"
+        self.person = person = "synthetic" if synthetic else "human"
         self.source = person if assist is None else f"{self.assist_name}+{person}"
         self.help = help_lines(config.device, self.kb)
         title = f"GymFG-IL: {flight.task_label} on {self.env.aircraft.model}"
