@@ -31,3 +31,18 @@ def test_unknown_model_names_the_closest():
 def test_callsign_must_be_named(callsign):
     with pytest.raises(ConfigError, match="callsign"):
         Aircraft("c172p", callsign)
+
+
+def test_profiles_say_how_much_longer_their_maneuvers_take():
+    from gymfg_il.aircraft import PROFILES, REFERENCE_PROFILE, FlightProfile
+
+    assert PROFILES["c172p"] is REFERENCE_PROFILE and REFERENCE_PROFILE.maneuver_scale == 1.0
+    # 400 kt at 45 deg of bank turns 1.7 times slower than 110 kt at 25 deg
+    assert PROFILES["f15"].maneuver_scale == pytest.approx(1.696, abs=1e-3)
+    assert PROFILES["f15"].turn_rate_dps == pytest.approx(2.73, abs=0.01)
+    assert FlightProfile(90.0, 5000.0, 0.7, 40.0, 14000.0).maneuver_scale == 1.0  # never < 1
+    assert (PROFILES["f15"].final_approach_kts, PROFILES["A320"].final_approach_kts) == (210, 200)
+    with pytest.raises(ConfigError, match="bank_deg=80"):
+        FlightProfile(110.0, 5000.0, 0.7, 50.0, 14000.0, bank_deg=80.0)
+    with pytest.raises(ConfigError, match="approach_kts=40"):
+        FlightProfile(110.0, 5000.0, 0.7, 50.0, 14000.0, approach_kts=40.0)
