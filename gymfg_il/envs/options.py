@@ -23,6 +23,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from gymfg_il.aircraft import Aircraft
 from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.envs.roster import AircraftSpec, TeamSpec
@@ -39,7 +40,10 @@ AIRCRAFT_OPTIONS = {
     "task_kwargs": "task_kwargs",
 }
 WEATHER_OPTIONS = ("turbulence", "wind_kt", "wind_from_deg")
-TASK_OWN_TIME = "the task's own: 90 s for most, 120 for waypoints, 180 for approach"
+TASK_OWN_TIME = (
+    "the task's own: 90 s for most, 120 for waypoints, 180 for approach (on the c172p; "
+    "the turns, waypoints and formation last longer on aircraft that turn slower)"
+)
 
 
 @dataclass
@@ -91,7 +95,10 @@ class FlightOptions:
             callsign="ego",
             **{AIRCRAFT_OPTIONS[k]: given.pop(k) for k in AIRCRAFT_OPTIONS if k in given},
         )
-        given.setdefault("episode_time_s", task_class(ego.task, ego.dynamic).episode_time_s)
+        profile = Aircraft(ego.model, ego.callsign).profile
+        given.setdefault(
+            "episode_time_s", task_class(ego.task, ego.dynamic).episode_time_for(profile)
+        )
         return FlightSpec(teams=(TeamSpec("ego", (ego,)),), **given)
 
     def env_config(self, views: Mapping[str, Sequence[int]] | None = None) -> EnvConfig:

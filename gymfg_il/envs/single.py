@@ -223,5 +223,8 @@ def _team_flying(task: type[Task] | Task, aircraft: str, options: FlightOptions)
     else:
         raise ConfigError(f"task={task!r} must be a family name, a Task class or instance")
     cls = task if isinstance(task, type) else type(task)
-    seconds = cls.episode_time_s if options.episode_time_s is None else options.episode_time_s
-    return Team("ego", [(Aircraft(aircraft, "ego"), spec)], episode_time_s=seconds)
+    ego = Aircraft(aircraft, "ego")
+    seconds = options.episode_time_s
+    if seconds is None:
+        seconds = cls.episode_time_for(ego.profile)
+    return Team("ego", [(ego, spec)], episode_time_s=seconds)

@@ -78,6 +78,12 @@ class Task:
     # how long an episode of this task lasts unless the flight says otherwise (seconds)
     episode_time_s: ClassVar[float] = 90.0
 
+    @classmethod
+    def episode_time_for(cls, profile: FlightProfile) -> float:
+        """How long an episode lasts on an aircraft of ``profile`` unless the flight says
+        otherwise (seconds): ``episode_time_s`` (maneuvers stretch it for slow turners)."""
+        return cls.episode_time_s
+
     def __new__(cls, *args: Any, **kwargs: Any) -> Task:
         # the arguments of the construction, whatever the subclass takes: what a flight spec
         # records (``options``) to build the same task again

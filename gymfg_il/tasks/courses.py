@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.aircraft import FlightProfile
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.geometry import offset_position
@@ -37,14 +38,17 @@ class WaypointsTask(ManeuverTask):
     | next_turn_deg | deg | the turn at the next gate onto the leg after it (0 at the last) |
     | gates_left | 1 | gates still to pass (3, 2, 1, 0) |
 
-    Plan: three gates, each 25-32 s of cruise flight from the one before (about 1.5 km for
-    the c172p, 6 km for the F-15), the first leg within 45 deg of the start heading, each
+    Plan: three gates, each 25-32 s of cruise flight times the aircraft's
+    ``maneuver_scale`` from the one before (1.4-1.8 km for the c172p, 8.7-11.2 km for the
+    f15, 7.4-9.5 km for the A320: the same number of its own turn radii, so each turns onto
+    the next leg as the c172p does), the first leg within 45 deg of the start heading, each
     later leg turned 20-60 deg either way, each gate 0-300 ft above or below the one before.
     A gate is passed within ``radius_ft`` (300) horizontally and ``altitude_tolerance_ft``
-    (150) vertically. Reward: ``0.5 exp(-distance / 3000) + 0.3 exp(-|altitude error| / 150)
-    + 0.2 exp(-|bearing error| / 20)`` minus the smoothness term. Success: all three gates
-    passed, in order.
-    Start and end: as every maneuver (module docstring); 120 s episodes.
+    (150) vertically, on every aircraft. Reward: ``0.5 exp(-distance / 3000) + 0.3
+    exp(-|altitude error| / 150) + 0.2 exp(-|bearing error| / 20)`` minus the smoothness
+    term. Success: all three gates passed, in order.
+    Start and end: as every maneuver (module docstring); 120 s episodes on the c172p, times
+    the aircraft's ``maneuver_scale`` (204 s on the f15, 247 on the A320).
     """
 
     name = "waypoints"
@@ -61,7 +65,8 @@ class WaypointsTask(ManeuverTask):
     altitude_tolerance_ft = 150.0
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
-        speed = self._profile().cruise_kts * KT_TO_FPS
+        profile = self._profile()
+        speed, scale = profile.cruise_kts * KT_TO_FPS, profile.maneuver_scale
         course = float(state[_HDG]) + float(rng.uniform(-45.0, 45.0))
         north = east = 0.0
         alt = float(state[_ALT])
@@ -69,7 +74,7 @@ class WaypointsTask(ManeuverTask):
         for k in range(3):
             if k:
                 course += float(rng.uniform(20.0, 60.0)) * (1.0 if rng.random() < 0.5 else -1.0)
-            leg = speed * float(rng.uniform(25.0, 32.0))
+            leg = speed * (float(rng.uniform(25.0, 32.0)) * scale)
             north += leg * math.cos(math.radians(course))
             east += leg * math.sin(math.radians(course))
             alt += float(rng.uniform(-300.0, 300.0))
@@ -162,15 +167,21 @@ class ApproachTask(ManeuverTask):
     | height_above_threshold_ft | ft | altitude - threshold elevation |
 
     Plan: a runway whose course is within 30 deg of the start heading, its threshold 3.5-4
-    NM ahead along the course, the aircraft up to 1,500 ft either side of the centre line and
-    0-300 ft below (or up to 100 ft above) the glide path; approach speed 1.4 x the
-    aircraft's stall speed (70 kt for the c172p), the start 10-40 % faster.
+    NM ahead along the course times the task's ``speed_scale`` (the approach speed over the
+    c172p's: 3 for the f15, 2.9 for the A320, so every aircraft has about the same time to
+    set up), the aircraft up to 1,500 ft either side of the centre line and 0-300 ft above
+    (or up to 100 ft below) the glide path; approach speed ``FlightProfile.final_approach_kts``
+    (1.4 x the aircraft's minimum airspeed: 70 kt for the c172p, 210 for the f15; 200 kt for
+    the A320, which cannot hold the slower speed clean), the start 10-40 % faster (true
+    airspeed). The judged final starts 2.5 NM out on every aircraft (about 800 ft above the
+    threshold, where a pilot is stabilized).
     Reward: ``0.4 exp(-|glide path error| / 100) + 0.4 exp(-|offset| / 300) + 0.2
     exp(-|speed error| / 10)`` minus the smoothness term.
     Success: the aircraft reaches the decision height (200 ft above the threshold on the
     path), and from 2.5 NM out down to it stays within 100 ft of the glide path, 200 ft of
     the centre line and 10 kt of the approach speed.
-    Start and end: as every maneuver (module docstring); 180 s episodes.
+    Start and end: as every maneuver (module docstring); 180 s episodes on every aircraft
+    (the final grows with the approach speed instead).
     """
 
     name = "approach"
@@ -191,8 +202,18 @@ class ApproachTask(ManeuverTask):
     hold_from_nm = 2.5
     tolerances = {"glide path": 100.0, "centre line": 200.0, "airspeed": 10.0}  # noqa: RUF012
 
+    @classmethod
+    def flown_kts(cls, profile: FlightProfile) -> float:
+        """The approach speed (``FlightProfile.final_approach_kts``)."""
+        return profile.final_approach_kts
+
+    @classmethod
+    def episode_time_for(cls, profile: FlightProfile) -> float:
+        """180 s on every aircraft: the final grows with the approach speed instead."""
+        return cls.episode_time_s
+
     def approach_kts(self) -> float:
-        return round(1.4 * self._profile().min_airspeed_kts, 1)
+        return self.flown_kts(self._profile())
 
     def initial_conditions(self, rng: np.random.Generator) -> InitialConditions:
         """Cruise altitude, any heading, 10-40 % above the approach speed (slowing from
@@ -204,19 +225,20 @@ class ApproachTask(ManeuverTask):
         return dataclasses.replace(ic, airspeed_kts=speed)
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
+        scale = self.speed_scale()
         course = wrap_360(float(state[_HDG]) + float(rng.uniform(-30.0, 30.0)))
-        distance = float(rng.uniform(3.5, 4.0)) * FT_PER_NM
+        distance = float(rng.uniform(3.5, 4.0)) * FT_PER_NM * scale
         offset = float(rng.uniform(-1500.0, 1500.0))
         c, s = math.cos(math.radians(course)), math.sin(math.radians(course))
         north, east = distance * c + offset * s, distance * s - offset * c
         lat0, lon0 = float(state[_LAT]), float(state[_LON])
         lat, lon = offset_position(lat0, lon0, north, east)
         tan = math.tan(math.radians(self.glide_deg))
-        below = float(rng.uniform(-100.0, 300.0))
+        above = float(rng.uniform(-100.0, 300.0))  # the start above the path
         return {
             "threshold": [lat, lon],
             "course_deg": course,
-            "threshold_ft": float(state[_ALT]) - distance * tan - below,
+            "threshold_ft": float(state[_ALT]) - distance * tan - above,
             "glide_deg": self.glide_deg,
             "approach_kts": self.approach_kts(),
             "decision_height_ft": self.decision_height_ft,

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.aircraft import REFERENCE_PROFILE
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX, indices
@@ -30,22 +31,35 @@ _ALT, _HDG = INDEX["altitude_ft"], INDEX["heading_deg"]
 _LAT, _LON = INDEX["lat_deg"], INDEX["lon_deg"]
 
 
+def _tas_over_cas(altitude_ft: float) -> float:
+    """True over calibrated airspeed at ``altitude_ft`` in the standard atmosphere, at low
+    Mach (the square root of sea level's air density over the density there)."""
+    return float((1.0 - 6.8756e-6 * altitude_ft) ** -2.12795)
+
+
 def _lead_schedule(
-    rng: np.random.Generator, steps: int, dt: float, altitude: float, heading: float
+    rng: np.random.Generator,
+    steps: int,
+    dt: float,
+    altitude: float,
+    heading: float,
+    scale: float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The lead's altitude and heading targets per step: straight for 10 s, then every 20-25
     s a new heading (20-60 deg either way, turned at 3 deg/s) and altitude (100-300 ft either
-    way, at 5 ft/s)."""
+    way, at 5 ft/s); the times stretched and the turn rate slowed by ``scale`` (the
+    aircraft's ``maneuver_scale``)."""
     alt_t, hdg_t = np.empty(steps + 1), np.empty(steps + 1)
     alt_goal, hdg_goal = altitude, heading
-    next_change = 10.0
+    next_change = 10.0 * scale
+    turn = 3.0 / scale * dt
     for i in range(steps + 1):
         t = i * dt
         if t >= next_change:
             hdg_goal += float(rng.uniform(20.0, 60.0)) * (1.0 if rng.random() < 0.5 else -1.0)
             alt_goal += float(rng.uniform(100.0, 300.0)) * (1.0 if rng.random() < 0.5 else -1.0)
-            next_change = t + float(rng.uniform(20.0, 25.0))
-        heading += max(-3.0 * dt, min(3.0 * dt, hdg_goal - heading))
+            next_change = t + float(rng.uniform(20.0, 25.0)) * scale
+        heading += max(-turn, min(turn, hdg_goal - heading))
         altitude += max(-5.0 * dt, min(5.0 * dt, alt_goal - altitude))
         alt_t[i], hdg_t[i] = altitude, wrap_360(heading)
     return alt_t, hdg_t
@@ -69,10 +83,18 @@ class FormationTask(ManeuverTask):
     Plan: the lead (same model) starts 250-450 ft ahead at 95 % of cruise speed, the
     follower up to 100 ft either side of and above or below the slot's line; the lead flies
     straight for 10 s, then every 20-25 s turns 20-60 deg (at 3 deg/s) and climbs or descends
-    100-300 ft (at 5 ft/s). Reward: ``exp(-distance to the slot / 100)`` minus the
-    smoothness term. Success: from 30 s on, within ``tolerance_ft`` (100) of the slot at
-    every step, and never within 50 ft of the lead.
-    Start and end: as every maneuver (module docstring); 90 s episodes.
+    100-300 ft (at 5 ft/s), its times stretched and its turn rate divided by the aircraft's
+    ``maneuver_scale`` (a lead banks about as far short of its limit on every aircraft). The
+    lead's autopilot holds 95 % of cruise as calibrated airspeed, scaled from the c172p's
+    altitude to the aircraft's own (calibrated falls further below true airspeed higher up;
+    unscaled, a jet's lead at its cruise altitude would speed up at full throttle, where no
+    follower of the same model can catch it). The slot and tolerances are the same on every
+    aircraft.
+    Reward: ``exp(-distance to the slot / 100)`` minus the smoothness term. Success: from 30
+    s on, within ``tolerance_ft`` (100) of the slot at every step, and never within 50 ft of
+    the lead.
+    Start and end: as every maneuver (module docstring); 90 s episodes on the c172p, times
+    the aircraft's ``maneuver_scale`` (153 s on the f15, 186 on the A320).
     """
 
     name = "formation"
@@ -105,8 +127,14 @@ class FormationTask(ManeuverTask):
         lat, lon = offset_position(float(state[_LAT]), float(state[_LON]), north, east)
         speed = 0.95 * profile.cruise_kts
         ic = InitialConditions(lat, lon, float(state[_ALT]) - up, heading, speed)
-        alt_t, hdg_t = _lead_schedule(rng, self.max_steps, self.dt, ic.altitude_ft, heading)
-        track = np.round(self._fly_lead(ic, alt_t, hdg_t, speed), 8)
+        alt_t, hdg_t = _lead_schedule(
+            rng, self.max_steps, self.dt, ic.altitude_ft, heading, profile.maneuver_scale
+        )
+        # the lead's target is a calibrated airspeed: 95 % of cruise at the reference's
+        # altitude, as much less higher up as calibrated airspeed falls short of true there
+        reference = _tas_over_cas(REFERENCE_PROFILE.cruise_altitude_ft)
+        target = speed * (reference / _tas_over_cas(profile.cruise_altitude_ft))
+        track = np.round(self._fly_lead(ic, alt_t, hdg_t, target), 8)
         self._lead = track  # as an array, for every step's observation
         return {"slot_ft": list(self.slot), "lead": track.tolist()}
 

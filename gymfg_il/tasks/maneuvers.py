@@ -8,8 +8,18 @@ success with the task's own rule, so a dataset, a log or an eval row is judged t
 Every maneuver observes ``FLIGHT_VARS`` and ``heading_deg`` first, then its own entries (see
 each task's table). Start: the aircraft's cruise profile (altitude +/- 500 ft, any heading,
 airspeed +/- 5 %, wings level). End: as every task (crash, stall, ceiling: ``terminated``;
-the episode time, each task's own ``episode_time_s`` unless the flight sets one:
-``truncated``). The action is ``[aileron, elevator, rudder, throttle]``.
+the episode time, each task's own ``episode_time_for`` its aircraft unless the flight sets
+one: ``truncated``). The action is ``[aileron, elevator, rudder, throttle]``.
+
+Every aircraft flies the same maneuvers in its own time and space. The plans were first drawn
+for a light aircraft (``aircraft.REFERENCE_PROFILE``, the c172p's: 110 kt, 25 deg of bank);
+an aircraft that turns slower at its profile's cruise speed and ``bank_deg`` stretches the
+times of a plan by its ``maneuver_scale`` (how many times longer its turns take: 1 for the
+c172p, 1.7 for the f15 at 45 deg of bank, 2.1 for the A320 at 30), and one that flies a
+maneuver faster stretches the distances flown in a given time by ``speed_scale``. Both are 1
+on the c172p, whose plans are those drawn before the scaling existed, bit for bit. Tolerances
+stay as a pilot states them (feet, degrees, knots) on every aircraft. The experts fly each
+maneuver banked at most ``bank_deg`` (``controllers.autopilot.scaled_for``).
 
 This module holds the shared machinery and the turn tasks; ``tasks.courses`` holds the tasks
 flown over the ground (waypoints, approach) and ``tasks.formation`` the formation slot.
@@ -23,6 +33,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from gymfg_il.aircraft import REFERENCE_PROFILE, FlightProfile
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
 from gymfg_il.tasks.rewards import RewardContext, action_change, closeness
@@ -68,6 +79,24 @@ class ManeuverTask(Task):
     episode_time_s: ClassVar[float] = 90.0
     # (variable, observation entry of target minus value, tolerance): what plots draw
     tracked_entry: ClassVar[tuple[str, str, float]] = ("heading_deg", "heading_deg_error", 3.0)
+
+    @classmethod
+    def episode_time_for(cls, profile: FlightProfile) -> float:
+        """``episode_time_s`` (the c172p's) stretched by the aircraft's maneuver scale, in
+        whole seconds: an aircraft that turns at half the rate gets twice the time."""
+        return float(math.ceil(cls.episode_time_s * profile.maneuver_scale))
+
+    @classmethod
+    def flown_kts(cls, profile: FlightProfile) -> float:
+        """The airspeed an aircraft of ``profile`` flies the maneuver at: its cruise."""
+        return profile.cruise_kts
+
+    def speed_scale(self) -> float:
+        """How many times faster than ``REFERENCE_PROFILE`` its aircraft flies the maneuver,
+        at least 1 (1 on the c172p): what the distances flown in the same time grow by, and
+        the experts' track and station gains shrink by."""
+        profile = self._profile()
+        return max(1.0, self.flown_kts(profile) / self.flown_kts(REFERENCE_PROFILE))
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
@@ -150,7 +179,8 @@ class TurnTask(ManeuverTask):
     Reward: ``0.6 exp(-|remaining| / 30) + 0.4 exp(-|altitude error| / 100)`` minus the usual
     smoothness term. Success: the altitude stays within 100 ft of the start throughout and
     the heading is within 5 deg of the new one over the last 10 s.
-    Start and end: as every maneuver (module docstring); 90 s episodes.
+    Start and end: as every maneuver (module docstring); 90 s episodes on the c172p, times
+    the aircraft's ``maneuver_scale`` (153 s on the f15, 186 on the A320).
     """
 
     name = "turn"
@@ -213,7 +243,8 @@ class ClimbTurnTask(ManeuverTask):
     Plan: an altitude change of 300-1,000 ft and a heading change of 30-90 deg, each either
     way. Reward: ``0.5 exp(-|altitude error| / 200) + 0.5 exp(-|heading error| / 10)`` minus
     the smoothness term. Success: within 50 ft and 3 deg of both over the last 10 s.
-    Start and end: as every maneuver (module docstring); 90 s episodes.
+    Start and end: as every maneuver (module docstring); 90 s episodes on the c172p, times
+    the aircraft's ``maneuver_scale`` (153 s on the f15, 186 on the A320).
     """
 
     name = "climb-turn"
