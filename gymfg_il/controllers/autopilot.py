@@ -17,11 +17,11 @@ flies a complete aircraft. ``controller_for(task)`` builds the one that matches 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gymfg_il.controllers.gains import Gains, gains_for
+from gymfg_il.controllers.gains import Gains, gains_for, maneuver_gains
 from gymfg_il.controllers.pid import PID
 from gymfg_il.errors import ConfigError
 from gymfg_il.tasks.orientation import bank_for_turn_rate
@@ -315,6 +315,17 @@ MANEUVER_TARGETS: dict[str, Targets] = {
 }
 
 
+def scaled_for(task: object, targets: Targets, model: str) -> tuple[Targets, Gains]:
+    """A maneuver's targets and gains on its aircraft (a bound task): the maneuver gains
+    (``gains.maneuver_gains``) banked at its profile's ``bank_deg``, the track gain divided
+    by the task's ``speed_scale`` (a line closed in the same seconds whatever the speed).
+    Unchanged on the c172p."""
+    profile = task.aircraft.profile  # type: ignore[attr-defined]
+    scale = task.speed_scale()  # type: ignore[attr-defined]
+    targets = replace(targets, track_gain=targets.track_gain / scale)
+    return targets, maneuver_gains(model, profile.bank_deg)
+
+
 def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0.7) -> Autopilot:
     """The autopilot that flies ``task`` (a bound Task): its target on the task's axis, the
     other axes held at their start values."""
@@ -322,6 +333,7 @@ def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0
     from gymfg_il.tasks.targets import TargetTask
 
     names = task.observation_names  # type: ignore[attr-defined]
+    gains = None
     if isinstance(task, TargetTask):
         var = task.family.variable
         source = f"{var}_target"
@@ -336,12 +348,15 @@ def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0
         }[key]
     elif getattr(task, "name", None) in MANEUVER_TARGETS:
         targets = MANEUVER_TARGETS[task.name]  # type: ignore[attr-defined]
+        aircraft = getattr(task, "aircraft", None)
+        if aircraft is not None:  # flown as its aircraft's pilot would (``scaled_for``)
+            targets, gains = scaled_for(task, targets, model)
     elif isinstance(task, LevelFlightTask):
         targets = Targets(lateral="heading", lateral_source=None)
     elif isinstance(task, DummyTask):
         targets = Targets()
     else:
         raise ConfigError(f"no controller for {type(task).__name__}; build an Autopilot yourself")
-    pilot = Autopilot(names, model, dt, targets)
+    pilot = Autopilot(names, model, dt, targets, gains)
     pilot.set_throttle_trim(throttle_trim)
     return pilot

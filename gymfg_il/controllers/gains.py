@@ -10,7 +10,7 @@ use ``GENERIC`` (a light-aircraft set).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 
 @dataclass(frozen=True)
@@ -63,9 +63,9 @@ GAINS: dict[str, Gains] = {
     "f15": Gains(
         pitch=(0.04, 0.01, 0.01),
         roll=(0.02, 0.01, 0.01),
-        climb=(0.15, 0.03, 0.0),
+        climb=(0.3, 0.1, 0.0),
         altitude_to_climb=0.12,
-        heading_to_roll=1.2,
+        heading_to_roll=1.5,
         speed=(0.02, 0.004, 0.0),
         sideslip=0.05,
         slip=(0.05, 0.05, 0.0),
@@ -77,9 +77,9 @@ GAINS: dict[str, Gains] = {
     "A320": Gains(
         pitch=(0.04, 0.01, 0.01),
         roll=(0.02, 0.01, 0.02),
-        climb=(0.15, 0.03, 0.0),
+        climb=(0.3, 0.1, 0.0),
         altitude_to_climb=0.1,
-        heading_to_roll=1.0,
+        heading_to_roll=1.5,
         speed=(0.03, 0.006, 0.0),
         sideslip=0.05,
         slip=(0.05, 0.05, 0.0),
@@ -90,8 +90,24 @@ GAINS: dict[str, Gains] = {
     ),
 }
 GENERIC = GAINS["c172p"]
+# Where the maneuvers need other loops than the target tasks. A jet's roll loop with the
+# target tasks' integral overshoots the bank it is asked for and, in a formation turn, sets
+# the slot swinging from side to side: half the integral holds it (a moving roll target needs
+# the whole, so the target tasks keep theirs). At 400 kt the f15 must also hold a heading to
+# a fraction of a degree to pass a gate or keep a slot: it banks 2 deg per deg of error.
+MANEUVER_ROLL = (0.02, 0.005, 0.015)
+MANEUVER_GAINS: dict[str, Gains] = {
+    "f15": replace(GAINS["f15"], roll=MANEUVER_ROLL, heading_to_roll=2.0),
+    "A320": replace(GAINS["A320"], roll=MANEUVER_ROLL),
+}
 
 
 def gains_for(model: str) -> Gains:
     """The gain set for a JSBSim model (the generic one when it has none of its own)."""
     return GAINS.get(model, GENERIC)
+
+
+def maneuver_gains(model: str, bank_deg: float) -> Gains:
+    """The gain set a maneuver flies ``model`` with: ``MANEUVER_GAINS``' where it has one,
+    else the model's, banked at most ``bank_deg`` (its profile's ``bank_deg``)."""
+    return replace(MANEUVER_GAINS.get(model) or gains_for(model), max_roll_deg=bank_deg)

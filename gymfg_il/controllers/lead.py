@@ -11,7 +11,9 @@ import dataclasses
 
 import numpy as np
 
+from gymfg_il.aircraft import Aircraft
 from gymfg_il.controllers.autopilot import Autopilot, Targets
+from gymfg_il.controllers.gains import maneuver_gains
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW, indices
 from gymfg_il.sim.simulation import Simulation
@@ -49,7 +51,9 @@ class LeadPilot:
         """The catalogue entries ``view`` of the lead at every step, from ``ic`` on, while
         the autopilot follows the targets (one per step) at ``speed_kts``."""
         targets = Targets(**{**_TARGETS.__dict__, "speed_source": float(speed_kts)})
-        pilot = Autopilot(_NAMES, self.model, self.dt, targets)
+        bank = Aircraft(self.model, "lead").profile.bank_deg  # flown as the maneuvers are
+        gains = maneuver_gains(self.model, bank)
+        pilot = Autopilot(_NAMES, self.model, self.dt, targets, gains)
         pilot.set_throttle_trim(throttle)
         sim = self.sim
         if ic.trimmed != self.trimmed:

@@ -105,3 +105,22 @@ def test_the_rudder_task_is_found_by_the_papers_name_and_its_dynamic_one_is_trac
     assert task_class("rudder") is ReachStaticTargetSideslipTask
     errors = fly("sideslip", "c172p", None, seconds=60, dynamic=True)
     assert errors[100:].max() < 1.0
+
+
+def test_maneuvers_bank_as_the_profile_says_and_close_lines_in_the_same_seconds():
+    from gymfg_il.controllers.autopilot import MANEUVER_TARGETS
+    from gymfg_il.controllers.gains import GAINS, MANEUVER_GAINS
+
+    def pilot(task, model):
+        env = AircraftEnv(task, model)
+        built = controller_for(env.task, model, env.dt)
+        env.close()
+        return built
+
+    c172 = pilot("approach", "c172p")  # the c172p flies its maneuvers as before the scaling
+    assert c172.targets == MANEUVER_TARGETS["approach"] and c172.gains == GAINS["c172p"]
+    jet = pilot("approach", "f15")
+    assert jet.gains.max_roll_deg == 45.0 and jet.gains.roll == MANEUVER_GAINS["f15"].roll
+    assert jet.targets.track_gain == pytest.approx(0.03 / 3.0)  # approaching 3x as fast
+    assert pilot("formation", "A320").targets.track_gain == pytest.approx(0.2 * 110.0 / 280.0)
+    assert pilot("heading", "f15").gains == GAINS["f15"]  # target tasks keep the model's set

@@ -1,13 +1,16 @@
 """The maneuvers: each task's success rule on constructed trajectories (a pass and a near
 miss), what they observe, and their experts flying real episodes."""
 
+import hashlib
+import json
 import math
 
 import numpy as np
 import pytest
 
-from gymfg_il.aircraft import c172p
+from gymfg_il.aircraft import Aircraft, c172p
 from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.evaluation.trace import trace_of
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.seeded import fly_many
@@ -15,10 +18,11 @@ from gymfg_il.sim.properties import INDEX, NAMES
 from gymfg_il.tasks.courses import ApproachTask, WaypointsTask
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.maneuvers import ClimbTurnTask, TurnTask
-from gymfg_il.units import FT_PER_NM
+from gymfg_il.units import FT_PER_NM, wrap_180
 
 DT = 0.1
 LAT, LON = 37.6, -122.4
+MANEUVERS = ["turn", "climb-turn", "waypoints", "formation", "approach"]
 
 
 def track(n, **columns):
@@ -162,10 +166,84 @@ def test_maneuvers_default_to_their_own_episode_time():
     assert FlightSpec.solo("c172p", "approach", episode_time_s=30).episode_time_s == 30
 
 
+def test_slower_turners_get_longer_maneuvers_in_whole_seconds():
+    # 90 s times the turn-rate ratio at cruise and the profile's bank, rounded up
+    assert FlightSpec.solo("f15", "turn").episode_time_s == 153.0
+    assert FlightSpec.solo("A320", "turn").episode_time_s == 186.0
+    assert FlightSpec.solo("A320", "waypoints").episode_time_s == 247.0
+    assert FlightSpec.solo("f15", "formation").episode_time_s == 153.0
+    assert FlightSpec.solo("A320", "approach").episode_time_s == 180.0  # its final grows instead
+    assert FlightSpec.solo("f15", "altitude").episode_time_s == 90.0  # not a maneuver
+    assert FlightSpec.solo("f15", "turn", episode_time_s=60).episode_time_s == 60
+    assert AircraftEnv(TurnTask, "f15").world.max_steps == 1530  # a task given as a class
+
+
+def bound(task_class, model, seed=3):
+    task = task_class()
+    task.bind(Aircraft(model, "x"), DT, 900)
+    if getattr(task, "needs_lead_pilot", False):
+        from gymfg_il.controllers.lead import LeadPilot
+
+        task.lead_pilot = LeadPilot(model, DT)
+    state = track(1, heading_deg=30.0, altitude_ft=Aircraft(model, "x").profile.cruise_altitude_ft)
+    task.reset(state[0], np.random.default_rng(seed))
+    return task
+
+
+def test_plans_scale_with_the_aircraft():
+    from gymfg_il.tasks.formation import FormationTask, _lead_schedule
+
+    c172, jet = bound(WaypointsTask, "c172p"), bound(WaypointsTask, "f15")
+    first = [math.hypot(*t.plan["gates"][0][:2]) for t in (c172, jet)]
+    # the same draws; legs as many seconds of cruise times the maneuver scale
+    assert first[1] / first[0] == pytest.approx(400.0 / 110.0 * jet._profile().maneuver_scale)
+    assert jet.plan["radius_ft"] == c172.plan["radius_ft"] == 300.0
+    c172, jet = bound(ApproachTask, "c172p"), bound(ApproachTask, "A320")
+    assert (c172.plan["approach_kts"], jet.plan["approach_kts"]) == (70.0, 200.0)
+    assert jet.speed_scale() == pytest.approx(200.0 / 70.0)
+    assert jet.plan["hold_from_ft"] == c172.plan["hold_from_ft"] == 2.5 * FT_PER_NM
+    # the lead's schedule: straight twice as long, then turned at half the rate
+    _, headings = _lead_schedule(np.random.default_rng(5), 900, DT, 5000.0, 10.0, scale=2.0)
+    turning = np.flatnonzero(np.diff(headings))
+    assert (turning[0] + 1) * DT == pytest.approx(20.0)
+    assert np.abs(wrap_180(np.diff(headings))).max() / DT == pytest.approx(1.5)
+    assert bound(FormationTask, "A320").plan["lead"]  # a lead of its own model flies it
+
+
+# the plans the c172p's maneuvers drew for seed 100 before plans scaled with the aircraft
+# (sha256 of describe()["plan"] as sorted JSON), and its experts' returns on seed 777
+C172P_PLANS = {
+    "turn": "a9bd35dc6d4f9818de7d2f74673e299b0f1c84ed5505da72a7a3e93e3071c706",
+    "climb-turn": "461257328ddcbf7fb3545c1edc8f15e13775f28b33a451301134983893ffe2a5",
+    "waypoints": "4a654d5b292827bcb083c6791a08d0b2fffe50238a7e26d3ff9d385ac17997cd",
+    "formation": "da0fb1f375ed807c12440aea840a6703936266dddbf79c75d91ef5300c3b63e1",
+    "approach": "5cecd5dcdc200227e12bd3307e6512753086ed0b41f49c8df49f4338a371668d",
+}
+C172P_RETURNS = {
+    "turn": 734.9468479041827,
+    "climb-turn": 615.2731642375754,
+    "waypoints": 831.4410726620433,
+    "formation": 622.2064911702164,
+    "approach": 1508.1172721907728,
+}
+
+
+@pytest.mark.parametrize("task", MANEUVERS)
+def test_the_c172p_flies_the_plans_and_returns_it_flew_before_the_scaling(task):
+    env = AircraftEnv(task, "c172p")
+    env.reset(seed=100)
+    plan = json.dumps(env.unwrapped.task.describe()["plan"], sort_keys=True)
+    env.close()
+    assert hashlib.sha256(plan.encode()).hexdigest() == C172P_PLANS[task]
+    (ep,) = fly_many(FlightSpec.solo("c172p", task), AgentSpec.controller(), [777])
+    assert ep.total_return == C172P_RETURNS[task]  # bit for bit
+
+
 # -- the experts, flying -------------------------------------------------------------------
-@pytest.mark.parametrize("task", ["turn", "climb-turn", "waypoints", "formation", "approach"])
-def test_expert_flies_the_maneuver(task):
-    flight = FlightSpec.solo("c172p", task)
+@pytest.mark.parametrize("model", ["c172p", "f15", "A320"])
+@pytest.mark.parametrize("task", MANEUVERS)
+def test_expert_flies_the_maneuver(task, model):
+    flight = FlightSpec.solo(model, task)
     episodes = fly_many(flight, AgentSpec.controller(), [7001, 7002])
     for ep in episodes:
         trace = trace_of(ep)
