@@ -15,7 +15,6 @@ import argparse
 import os
 import tempfile
 from pathlib import Path
-from typing import Any
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -81,7 +80,7 @@ def main(argv: list[str] | None = None) -> int:
             shot = round((args.at or 20.0) * hz) + 2
             pilot = SyntheticDriver()
 
-            def on_frame(frame: int, session: ManualSession) -> Any:
+            def on_frame(frame: int, session: ManualSession) -> None:
                 if frame == shot:
                     session.gui.screenshot(target)
                     key(pygame.K_q)
