@@ -14,7 +14,7 @@ from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.typecheck import type_problems
 
 DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
-EPOCHS_AUTOPILOT, EPOCHS_PERSON = 60, 10  # the default epochs (TrainConfig.epochs)
+EPOCHS_AUTOPILOT, EPOCHS_PERSON = 60, 20  # the default epochs (TrainConfig.epochs)
 
 
 @dataclass
@@ -28,7 +28,7 @@ class TrainConfig:
             (``policies.factory``) with its settings; on the command line ``--policy`` names
             its type and each setting is a flag of its own.
         epochs: passes over the training samples (default: 60 for an autopilot's
-            demonstrations, 10 where a person or the synthetic pilot flew any of them;
+            demonstrations, 20 where a person or the synthetic pilot flew any of them;
             a policy type may cap it, vision at 20).
         batch_size: samples (frames, or a policy's windows of frames) per gradient step.
         lr: AdamW learning rate (cosine-decayed to 5 % over the run).

@@ -141,4 +141,4 @@ def test_default_epochs_follow_who_demonstrated(tiny_dataset):
         sources = list(frames.episodes["gymfg/source"])
         sources[2] = person
         frames.episodes = {**frames.episodes, "gymfg/source": sources}
-        assert default_epochs(frames) == EPOCHS_PERSON == 10
+        assert default_epochs(frames) == EPOCHS_PERSON == 20
