@@ -286,7 +286,6 @@ class ManualSession:
                 if last_start is not None:
                     self.stats.periods.append(start - last_start)
                 last_start = start
-                self.display = self._look()
                 if self.on_frame is not None:
                     self.on_frame(frame, self)
                 events = pygame.event.get()
@@ -303,8 +302,10 @@ class ManualSession:
                 if running and self.state == "recording":
                     self._step()
                 self.updater.poll()
+                # once a frame, after what changed it: the window draws it now, and the
+                # synthetic pilot reads the same at the start of the next frame
+                self.display = self._look()
                 if self.draw:
-                    self.display = self._look()
                     self._draw()
                 frame += 1
                 self.stats.frames = frame
