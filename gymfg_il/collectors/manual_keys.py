@@ -44,4 +44,11 @@ def help_lines(device: str, kb: KeyboardBindings) -> list[str]:
         f"THROTTLE {keys(kb.throttle_up)}  |  {keys(kb.throttle_down)}",
         f"CENTRE   {keys(kb.center)}  (surfaces return to the trim at {kb.centering:g}/s)",
     ]
+    if device != "joystick":
+        lines += [
+            f"TRIM     elevator {keys(kb.trim_nose_down)} (nose down)  |  "
+            f"{keys(kb.trim_nose_up)} (nose up)",
+            f"         rudder {keys(kb.trim_rudder_left)}  |  {keys(kb.trim_rudder_right)}"
+            f"  ({kb.trim_rate:g}/s; the ticks on the stick box and rudder bar)",
+        ]
     return lines

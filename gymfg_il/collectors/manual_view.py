@@ -49,6 +49,7 @@ def window_frame(session: ManualSession) -> GuiFrame:
         notes = session.briefing
     return GuiFrame(
         action=session.human.values if human else session.last_action,
+        trim=session.human.neutral if human else None,
         variables={n: (float(state[INDEX[n]]), BY_NAME[n].unit) for n in SHOWN},
         display=session.display,
         notes=notes,

@@ -2,8 +2,9 @@
 
 Defaults follow FlightGear where it has a convention (arrows for elevator and aileron, with Up
 pushing the nose down; keypad 0/Enter for rudder; Page Up/Down for throttle; keypad 5 to
-centre). Every field can be set in a recipe's ``[collector.keyboard]``, ``[collector.mouse]``
-or ``[collector.joystick]`` table; keys are pygame key names (``pygame.key.name``).
+centre; Home/End and keypad 7/1 for elevator trim, nose down and nose up). Every field can be
+set in a recipe's ``[collector.keyboard]``, ``[collector.mouse]`` or ``[collector.joystick]``
+table; keys are pygame key names (``pygame.key.name``).
 """
 
 from __future__ import annotations
@@ -21,14 +22,21 @@ CONTROLS = ("aileron", "elevator", "rudder", "throttle")
 class KeyboardBindings:
     """Keyboard flying: holding a key moves its control at ``rate`` per second; released
     surfaces return to their neutral (the trim) at ``centering`` per second (0 = they stay).
+    Holding a trim key moves the neutral (and the surface with it) at ``trim_rate`` per
+    second, so a steady deflection (a slower speed's nose-up elevator, a held sideslip's
+    rudder) stays without a key held.
 
     Attributes:
         aileron_left, aileron_right, elevator_down, elevator_up: key names (several allowed).
         rudder_left, rudder_right, throttle_up, throttle_down: key names (several allowed).
-        center: key that centres the three surfaces at once.
+        trim_nose_down, trim_nose_up: elevator trim keys (FlightGear's Home/End, keypad 7/1).
+        trim_rudder_left, trim_rudder_right: rudder trim keys (Insert/Delete; FlightGear
+            has no plain-key rudder trim).
+        center: key that centres the three surfaces at once (on the trim).
         rate: surface travel per second while a key is held (full range = 2).
         throttle_rate: throttle travel per second while a key is held.
         centering: surface return-to-centre speed per second after release (0 = off).
+        trim_rate: trim travel per second while a trim key is held.
     """
 
     aileron_left: list[str] = field(default_factory=lambda: ["left", "[4]"])
@@ -39,13 +47,18 @@ class KeyboardBindings:
     rudder_right: list[str] = field(default_factory=lambda: ["enter", "."])
     throttle_up: list[str] = field(default_factory=lambda: ["page up", "[9]"])
     throttle_down: list[str] = field(default_factory=lambda: ["page down", "[3]"])
+    trim_nose_down: list[str] = field(default_factory=lambda: ["home", "[7]"])
+    trim_nose_up: list[str] = field(default_factory=lambda: ["end", "[1]"])
+    trim_rudder_left: list[str] = field(default_factory=lambda: ["insert"])
+    trim_rudder_right: list[str] = field(default_factory=lambda: ["delete"])
     center: list[str] = field(default_factory=lambda: ["[5]", "5"])
     rate: float = 1.5
     throttle_rate: float = 0.5
     centering: float = 1.0
+    trim_rate: float = 0.1
 
     def __post_init__(self) -> None:
-        _check_positive(self, ("rate", "throttle_rate"), allow_zero=("centering",))
+        _check_positive(self, ("rate", "throttle_rate", "trim_rate"), allow_zero=("centering",))
 
 
 @dataclass

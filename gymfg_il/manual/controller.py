@@ -6,11 +6,12 @@ JOYAXISMOTION, ...), never from polling, so injected events drive it exactly lik
 The ``flightgear`` device reads FlightGear's controls stream instead (``flightgear.cockpit``),
 at every ``handle`` and ``act``.
 
-The stick's neutral is the episode's start controls (``start_from``: a trimmed start's trim),
-as trim sets a real stick's neutral: released keys centre the surfaces on it, the mouse
-pointer and the joystick deflect from it with their full travel (``bindings.deflect``: full
-stick either way is the full command), and the centre key returns to it. The action is the
-whole command, so a hands-off pilot flies the trim.
+The stick's neutral is the trim: the episode's start controls (``start_from``: a trimmed
+start's trim), moved by the trim keys (elevator and rudder) as a real trim wheel moves a
+stick's neutral: released keys centre the surfaces on it, the mouse pointer and the joystick
+deflect from it with their full travel (``bindings.deflect``: full stick either way is the
+full command), and the centre key returns to it. The action is the whole command, so a
+hands-off pilot flies the trim.
 """
 
 from __future__ import annotations
@@ -80,6 +81,7 @@ class ManualController:
         self.joysticks: dict[int, Any] = {}  # instance id -> pygame Joystick (or None)
         self.status = ""
         self._key_of = self._index_keys()
+        self._trim_of = self._index_trims()
         self.cockpit: CockpitReceiver | None = None
         if device == "flightgear":
             from gymfg_il.flightgear.cockpit import CockpitReceiver
@@ -101,6 +103,20 @@ class ManualController:
             (k.rudder_right, 2, 1.0),
             (k.throttle_up, 3, 1.0),
             (k.throttle_down, 3, -1.0),
+        ):
+            for name in names:
+                out[name] = (idx, sign)
+        return out
+
+    def _index_trims(self) -> dict[str, tuple[int, float]]:
+        """trim key name -> (control index, direction)."""
+        k = self.keys
+        out: dict[str, tuple[int, float]] = {}
+        for names, idx, sign in (
+            (k.trim_nose_down, 1, 1.0),
+            (k.trim_nose_up, 1, -1.0),
+            (k.trim_rudder_left, 2, -1.0),
+            (k.trim_rudder_right, 2, 1.0),
         ):
             for name in names:
                 out[name] = (idx, sign)
@@ -171,6 +187,12 @@ class ManualController:
         k = self.keys
         moved = [False] * 4
         for name in self.held:
+            trim = self._trim_of.get(name)
+            if trim is not None:  # the neutral moves, and the surface with it
+                idx, sign = trim
+                old = self.neutral[idx]
+                self.neutral[idx] = np.clip(old + sign * k.trim_rate * dt, -1.0, 1.0)
+                self.values[idx] += self.neutral[idx] - old
             hit = self._key_of.get(name)
             if hit is None:
                 continue

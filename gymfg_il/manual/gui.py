@@ -28,6 +28,7 @@ class GuiFrame:
     """What one frame shows."""
 
     action: np.ndarray
+    trim: np.ndarray | None = None  # the surfaces' neutral (aileron, elevator, rudder)
     variables: dict[str, tuple[float, str]] = field(default_factory=dict)  # name -> (value, unit)
     display: Display | None = None  # the instruments' and the panel's readings
     notes: list[str] = field(default_factory=list)  # the briefing, or the debrief
@@ -83,13 +84,21 @@ class ControlsGUI:
         a = f.action
         dot = (box.centerx + a[0] * box.width / 2, box.centery - a[1] * box.height / 2)
         pg.draw.circle(s, ACCENT, (int(dot[0]), int(dot[1])), 9)
+        if f.trim is not None:  # the trim: ticks on the box's left edge and the rudder bar
+            ty = int(box.centery - f.trim[1] * box.height / 2)
+            pg.draw.line(s, AMBER, (box.left - 10, ty), (box.left + 6, ty), 3)
+            tx = int(40 + 120 + f.trim[2] * 120)
+            pg.draw.line(s, AMBER, (tx, 348), (tx, 356), 3)
         self._text("stick (aileron, elevator)", (40, 36), DIM, self.small)
         # rudder: horizontal bar under the stick
         rud = pg.Rect(40, 330, 240, 18)
         pg.draw.rect(s, DIM, rud, 1)
         x = rud.centerx + a[2] * rud.width / 2
         pg.draw.line(s, AMBER, (x, rud.top), (x, rud.bottom), 4)
-        self._text(f"rudder {a[2]:+.2f}", (40, 352), DIM, self.small)
+        rudder = f"rudder {a[2]:+.2f}"
+        if f.trim is not None:
+            rudder += f"   trim: elevator {f.trim[1]:+.2f}  rudder {f.trim[2]:+.2f}"
+        self._text(rudder, (40, 358), DIM, self.small)
         # throttle: vertical bar
         thr = pg.Rect(300, 60, 26, 240)
         pg.draw.rect(s, DIM, thr, 1)

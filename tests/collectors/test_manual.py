@@ -279,3 +279,38 @@ def test_a_trimmed_stick_keeps_its_full_travel():
             v = deflection(trim, command)
             assert -1.0 <= v <= 1.0 and deflect(trim, v) == pytest.approx(command)
     assert deflect(0.18, 0.5) == pytest.approx(0.59) and deflect(0.18, -0.5) == -0.41
+
+
+def test_trim_keys_move_the_neutral_the_surface_stays_on(tmp_path):
+    script = {
+        1: [lambda: key(pygame.K_SPACE)],
+        3: [lambda: key(pygame.K_END)],  # elevator trim nose up, 30 frames at 0.1/s
+        33: [lambda: key(pygame.K_END, False)],
+        40: [lambda: key(pygame.K_DELETE)],  # rudder trim right, 15 frames
+        55: [lambda: key(pygame.K_DELETE, False)],
+        60: [lambda: key(pygame.K_UP)],  # nose down 6 frames, then released: back to the trim
+        66: [lambda: key(pygame.K_UP, False)],
+        200: [lambda: key(pygame.K_q)],
+    }
+    stats = run(tmp_path, script)
+    assert stats.saved == 1
+    frames = load_frames(tmp_path / "dataset")
+    elevator, rudder = frames.action[:, 1], frames.action[:, 2]
+    start_elevator, start_rudder = elevator[0], rudder[0]
+    # session frame k flies dataset frame k - 1: trim held for session frames 3..32
+    assert elevator[31] == pytest.approx(start_elevator - 30 * 0.1 / 30, abs=1e-6)
+    assert elevator[50] == elevator[31]  # released, the surface stays on the new trim
+    assert rudder[54] == pytest.approx(start_rudder + 15 * 0.1 / 30, abs=1e-6)
+    # a surface key's deflection centres back on the new trim, not on the start's
+    assert elevator[64] > elevator[31] + 0.2
+    assert elevator[89] == pytest.approx(elevator[31], abs=1e-6)
+    assert rudder[89] == pytest.approx(rudder[54], abs=1e-6)
+
+
+def test_the_help_names_the_trim_keys():
+    from gymfg_il.collectors.manual_keys import help_lines
+    from gymfg_il.manual.bindings import KeyboardBindings
+
+    text = "\n".join(help_lines("keyboard", KeyboardBindings()))
+    assert "TRIM" in text and "home" in text and "end" in text and "delete" in text
+    assert "TRIM" not in "\n".join(help_lines("joystick", KeyboardBindings()))
