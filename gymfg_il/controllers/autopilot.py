@@ -45,8 +45,6 @@ class Targets:
     behind the point the aircraft is (ft) and ``station_rate_source`` how fast that grows
     (ft/s); the airspeed target is the airspeed plus ``station_gains`` (kt per ft, kt per
     ft/s) times them, at most 20 kt either way.
-    ``bank_source`` (heading and track): the bank the heading loop starts from (another
-    aircraft's, to turn with it), instead of the bank of the target's own turn rate.
     """
 
     vertical: str = "altitude"  # "altitude", "pitch" or "climb"
@@ -62,7 +60,6 @@ class Targets:
     station_source: str | None = None
     station_rate_source: str | None = None
     station_gains: tuple[float, float] = (0.4, 2.0)
-    bank_source: str | None = None
 
 
 class Autopilot:
@@ -104,8 +101,6 @@ class Autopilot:
             need.append(str(targets.track_source))
         if targets.station_source is not None:
             need += [targets.station_source, str(targets.station_rate_source)]
-        if targets.bank_source is not None:
-            need.append(targets.bank_source)
         for source in (targets.vertical_source, targets.lateral_source, targets.speed_source):
             if isinstance(source, str):
                 need.append(source)
@@ -242,12 +237,7 @@ class Autopilot:
             turn = 0.0 if last is None else wrap_180(heading_target - last) / dt
             if abs(turn) > MAX_FEED_FORWARD_TURN_DEG_S:
                 turn = 0.0
-            ahead = (
-                bank_for_turn_rate(turn, obs[i["airspeed_kts"]])
-                if t.bank_source is None
-                else obs[i[t.bank_source]]
-            )
-            roll_target = g.heading_to_roll * err + ahead
+            roll_target = g.heading_to_roll * err + bank_for_turn_rate(turn, obs[i["airspeed_kts"]])
         else:
             roll_target = self._value(obs, t.lateral_source, "roll_deg")
         roll_target = (

@@ -3,16 +3,18 @@
 A person at the collector's window has the display model (``display.readings``): the
 instruments, the targets as bugs and the task's guidance, nothing else; no observation
 vector, no integral, no body rate. ``DisplayIntent`` is the intent of the synthetic pilot:
-the task's expert loops (``controllers.autopilot``, flown with a person's hands:
-``hands_of``), fed only with readings the window draws, and with the two rates a person reads
-from the moving attitude indicator (how fast the horizon rolls and pitches). Each task's
-targets are taken from its bugs and guidance (``DISPLAY_SOURCES``); a reading the window does
-not draw cannot be read: building the intent for a task fails if its loops need one.
+the task's expert loops (``controllers.autopilot``, flown with a person's hands on that
+aircraft: ``Hands``, ``hands_of``), fed only with readings the window draws, and with the
+two rates a person reads from the moving attitude indicator (how fast the horizon rolls and
+pitches). Each task's targets are taken from its bugs and guidance (``DISPLAY_SOURCES``); a
+reading the window does not draw cannot be read: building the intent for a task fails if its
+loops need one.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -28,8 +30,32 @@ MOTION = {"p_rad_s": "roll_deg", "q_rad_s": "pitch_deg"}
 ANGLES = {"heading_deg", "heading_deg_target", "gate_bearing_deg", "lead_heading_deg"}
 ANGLES |= {"runway_course_deg", "roll_deg", "lead_roll_deg"}
 _NONE: frozenset[str] = frozenset()
-PITCH_DAMPING = 0.5  # of the expert's pitch-rate gain
-SLIP_GAIN = 0.4  # of the expert's slip gains (the integral's half of that)
+
+
+@dataclass(frozen=True)
+class Hands:
+    """How a person flies the expert's loops on one aircraft (``hands_of``).
+
+    Attributes:
+        pitch_damping: share of the expert's pitch-rate gain (a person reads the pitch rate
+            off the moving horizon, late and imprecisely, where an autopilot has a gyro).
+        slip_gain: share of the expert's slip gains, the integral's half of that (keyboard
+            taps held against a P+I slip loop chatter past the tolerance).
+        station: share of the expert's station-keeping gains (how hard it chases a formation
+            slot; with the expert's, its quarter-second delay made it surge past and fall back).
+        anticipate: how far it leads a moving reading, as a share of its delay
+            (``manual.synthetic``): a person leads an agile aircraft, whose attitude moves
+            within its reaction time, and not a slow one, whose readings it would only shake.
+    """
+
+    pitch_damping: float = 0.5
+    slip_gain: float = 0.4
+    station: float = 0.5
+    anticipate: float = 0.0
+
+
+# tuned on seeds 100-115 (docs/results/cockpit.md); an aircraft not named flies with Hands()
+HANDS: dict[str, Hands] = {"f15": Hands(anticipate=0.5)}
 # where each task's loops take their targets from on the display (the expert's other settings
 # and gains stay); a target task's bug is named as the expert's source already
 DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
@@ -45,7 +71,6 @@ DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
     },
     "formation": {
         "lateral_source": "lead_heading_deg",
-        "bank_source": "lead_roll_deg",
         "relative": frozenset({"vertical"}),
     },
     "approach": {
@@ -61,15 +86,13 @@ DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
 }
 
 
-def hands_of(gains: Gains) -> Gains:
-    """The expert's gains as a person's hands fly them: less pitch damping (a person reads the
-    pitch rate off the moving horizon, late and imprecisely, where an autopilot has a rate
-    gyro) and a gentler rudder on a slip (keyboard taps held against a P+I slip loop chatter
-    past the tolerance)."""
+def hands_of(gains: Gains, hands: Hands) -> Gains:
+    """The expert's gains as a person's ``hands`` fly them (``Hands``)."""
     kp, ki, kd = gains.pitch
     skp, ski, skd = gains.slip
+    slip = hands.slip_gain
     return dataclasses.replace(
-        gains, pitch=(kp, ki, kd * PITCH_DAMPING), slip=(skp * SLIP_GAIN, ski * SLIP_GAIN / 2, skd)
+        gains, pitch=(kp, ki, kd * hands.pitch_damping), slip=(skp * slip, ski * slip / 2, skd)
     )
 
 
@@ -90,11 +113,14 @@ class DisplayIntent:
         expert = controller_for(task, model, dt, throttle)
         sources = DISPLAY_SOURCES.get(str(getattr(task, "name", "")), {})
         targets = dataclasses.replace(expert.targets, **sources)
+        self.hands = HANDS.get(model, Hands())
+        station = tuple(g * self.hands.station for g in targets.station_gains)
+        targets = dataclasses.replace(targets, station_gains=station)
         self.readings = reading_names(task)
         self.names = (*self.readings, *MOTION)
         self.angular = np.array([n in ANGLES for n in self.names])
         self.dt = dt
-        gains = hands_of(expert.gains)
+        gains = hands_of(expert.gains, self.hands)
         self.autopilot = Autopilot(self.names, model, dt, targets, gains=gains)
         self.autopilot.set_throttle_trim(throttle)
         self._last: dict[str, float] | None = None

@@ -6,13 +6,21 @@ draws (the display model, ``display.readings``); what it wants to do with that c
 task's expert loops fed with those readings (its "intent", ``manual.perception``: a competent
 pilot knows what the aircraft needs); how it gets there is human:
 
-- it reacts to what it saw ``reaction_s`` ago, and reads the instruments imprecisely (its
-  misreadings drift over about a second);
+- it reacts to what it saw ``reaction_s`` ago; on an agile aircraft it leads what it saw as
+  a person leads a moving needle, extrapolating each reading's trend over the last
+  ``TREND_S`` by its hands' ``anticipate`` share of its delay (``manual.perception.Hands``;
+  without it the delay made the f15's formation loops weave off the slot);
+- it reads the instruments imprecisely: its misreadings drift smoothly over about a second,
+  in proportion to how lively each reading has been over that second;
 - on the keyboard it can only hold keys: it presses one when the stick is off what it wants by
   more than its ``deadband``, and lets go only once the stick has passed the mark by its
   ``overshoot`` (over-corrections), while the controller's centring pulls the stick back;
 - a joystick or mouse hand shakes (``tremor``) and a stick reads in steps (``quantum``);
-- now and then its attention lapses: for ``lapse_s`` it lets go of the keys and holds still.
+- now and then its attention lapses: for ``lapse_s`` it lets go of the keys and holds still;
+- on the keyboard it trims: when the elevator or rudder it has wanted over the last few
+  seconds (``TRIM_S``) sits off the trim by more than ``TRIM_BAND``, it holds the trim key
+  until the trim passes it (the trim ticks are drawn beside the stick), so a steady
+  deflection needs no key held.
 
 ``Skill.of(level)`` sets all of these from one number, 0 (a novice) to 1 (an ace). The same
 seed makes the same pilot make the same mistakes, so its demonstrations reproduce.
@@ -47,6 +55,11 @@ from gymfg_il.units import wrap_180
 
 CONTROLS = ("aileron", "elevator", "rudder", "throttle")
 MISREAD_S = 1.0  # how long a reading error lasts (the time constant of its drift)
+SMOOTHED = float(np.sqrt(2.0))  # the drift's std is the misread's over sqrt(2): restore it
+TREND_S = 0.2  # over how long it judges a reading's trend (to lead it)
+TRIM_S = 3.0  # over how long the pilot judges the steady deflection it trims out
+TRIM_BAND = 0.02  # how far the trim may sit off that deflection before it trims
+TRIMMED = (1, 2)  # the surfaces with trim keys: elevator, rudder
 
 
 @dataclass(frozen=True)
@@ -153,6 +166,10 @@ class SyntheticPilot:
             2: (self.keys.rudder_left[0], self.keys.rudder_right[0]),
             3: (self.keys.throttle_down[0], self.keys.throttle_up[0]),
         }
+        self._trim_names = {
+            1: (self.keys.trim_nose_up[0], self.keys.trim_nose_down[0]),
+            2: (self.keys.trim_rudder_left[0], self.keys.trim_rudder_right[0]),
+        }
         self.reset(seed)
 
     # -- episode ---------------------------------------------------------------------------
@@ -160,15 +177,21 @@ class SyntheticPilot:
         self.rng = np.random.default_rng([0 if seed is None else seed, 104729])
         self.intent.reset(seed)
         delay = max(1, round(self.skill.reaction_s / self.dt))
-        self._seen: collections.deque[np.ndarray] = collections.deque(maxlen=delay)
+        self._delay, self._trend = delay, max(1, round(TREND_S / self.dt))
+        self._anticipate = getattr(getattr(self.intent, "hands", None), "anticipate", 0.0)
+        self._seen: collections.deque[np.ndarray] = collections.deque(maxlen=delay + self._trend)
         self._held: dict[int, int] = {}  # control index -> direction (+1 / -1) of the key held
         self._axes: dict[int, float] = {}  # joystick axis -> the value last sent
         self._pointer: tuple[int, int] | None = None
         self._lapse_left = 0.0
         self._last_obs: np.ndarray | None = None
         self._misread: np.ndarray | None = None  # each reading's error, in its own stds
+        self._drift = np.zeros(0)  # the misread, smoothed: what the pilot's reading is off by
+        self._lively = np.zeros(0)  # each reading's change per second, over about a second
         self._plugged = False
         self.neutral: np.ndarray = np.zeros(3)  # the stick's neutral (start_from moves it)
+        self._trimming: dict[int, int] = {}  # control index -> direction of the trim key held
+        self._steady: np.ndarray | None = None  # the deflection wanted over the last TRIM_S
         self.sent: list[Any] = []
         self.pressed: list[tuple[str, bool]] = []  # (key, down) this frame, for the record
 
@@ -179,18 +202,31 @@ class SyntheticPilot:
         obs = read
         if self._misread is None:
             self._misread = np.zeros(len(read))
+            self._drift = np.zeros(len(read))
+            self._lively = np.zeros(len(read))
         if self.skill.perception and self._last_obs is not None:
             change = read - self._last_obs
             change[self.intent.angular] = wrap_180(change[self.intent.angular])
-            change = np.abs(change) / self.dt  # how lively each reading is
-            # a misjudgement drifts over about a second, it does not flicker frame by frame
+            # how lively each reading is: its change over about the last second (a jerk of
+            # one frame does not make the pilot misread it more)
             keep = np.exp(-self.dt / MISREAD_S)
+            self._lively = keep * self._lively + (1.0 - keep) * np.abs(change) / self.dt
+            # a misjudgement drifts smoothly over about a second; it neither flickers frame by
+            # frame nor jerks (a loop that differences a reading would take the jerks for rates)
             fresh = self.rng.normal(0.0, 1.0, len(read)) * np.sqrt(1.0 - keep * keep)
             self._misread = keep * self._misread + fresh
-            obs = read + self._misread * self.skill.perception * change
+            self._drift = keep * self._drift + (1.0 - keep) * self._misread
+            obs = read + SMOOTHED * self._drift * self.skill.perception * self._lively
         self._last_obs = read
         self._seen.append(obs)
-        return self._seen[0]
+        seen = self._seen[max(0, len(self._seen) - self._delay)]
+        older = len(self._seen) - self._delay - self._trend
+        if not self._anticipate or older < 0:
+            return seen
+        # a person leads a moving reading: it extrapolates what it saw by its own delay
+        trend = seen - self._seen[older]
+        trend[self.intent.angular] = wrap_180(trend[self.intent.angular])
+        return seen + self._anticipate * trend * (self._delay / self._trend)
 
     def _lapsing(self) -> bool:
         if self._lapse_left > 0:
@@ -224,7 +260,7 @@ class SyntheticPilot:
         if self._lapsing():
             out += self._let_go()
         elif self.device == "keyboard":
-            out += self._keyboard(want, stick, range(4))
+            out += self._keyboard(want, stick, range(4)) + self._trim(want)
         elif self.device == "mouse":  # the pointer is the stick; rudder and throttle are keys
             out += self._mouse(want) + self._keyboard(want, stick, (2, 3))
         else:
@@ -239,7 +275,35 @@ class SyntheticPilot:
 
     def _let_go(self) -> list[Any]:
         out = [self._key(self._key_names[i][(d + 1) // 2], False) for i, d in self._held.items()]
+        out += [
+            self._key(self._trim_names[i][(d + 1) // 2], False) for i, d in self._trimming.items()
+        ]
         self._held.clear()
+        self._trimming.clear()
+        return out
+
+    def _trim(self, want: np.ndarray) -> list[Any]:
+        """Trim out the steady deflection: hold a trim key while the deflection wanted over
+        the last ``TRIM_S`` sits off the trim by ``TRIM_BAND``, until the trim passes it.
+        The trim moves as the ManualController moves it (``trim_rate`` while held)."""
+        keep = np.exp(-self.dt / TRIM_S)
+        wanted = want[:3]
+        self._steady = (
+            wanted.copy() if self._steady is None else keep * self._steady + (1 - keep) * wanted
+        )
+        out = []
+        for i in TRIMMED:
+            held = self._trimming.get(i)
+            error = float(self._steady[i] - self.neutral[i])
+            if held is None and abs(error) > TRIM_BAND:
+                self._trimming[i] = 1 if error > 0 else -1
+                out.append(self._key(self._trim_names[i][(self._trimming[i] + 1) // 2], True))
+            elif held is not None and held * error <= 0:
+                del self._trimming[i]
+                out.append(self._key(self._trim_names[i][(held + 1) // 2], False))
+        step = self.keys.trim_rate * self.dt
+        for i, held in self._trimming.items():  # the controller moves it this frame
+            self.neutral[i] = np.clip(self.neutral[i] + held * step, -1.0, 1.0)
         return out
 
     def _keyboard(self, want: np.ndarray, stick: np.ndarray, controls: Any) -> list[Any]:

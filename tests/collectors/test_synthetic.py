@@ -99,3 +99,60 @@ def test_the_pilot_who_sees_only_the_window_flies_each_maneuver(tmp_path, task, 
     session.run()
     assert session.debrief is not None
     assert session.debrief.success, session.debrief.lines
+
+
+def test_the_pilot_trims_out_a_held_rudder_and_knows_where_its_trim_is():
+    # a sideslip asks for rudder held for the whole episode: the pilot trims it out on the
+    # keyboard's trim keys, and its own idea of the trim is the controller's trim
+    from gymfg_il.envs.options import FlightOptions
+    from gymfg_il.rollout.agents import AgentSpec
+
+    env = FlightOptions(task="sideslip", agent_hz=30, episode_time_s=30).flight().make_env()
+    agent = AgentSpec.synthetic("keyboard", 0.7).make(env)
+    obs, _ = env.reset(seed=5)
+    agent.reset(5)
+    agent.start_from(env.world.slots[0].action)
+    start = agent.human.neutral.copy()
+    trims = 0
+    done = False
+    while not done:
+        obs, _, terminated, truncated, _ = env.step(agent.act(obs))
+        trims += sum(down and name in ("insert", "delete") for name, down in agent.pilot.pressed)
+        done = terminated or truncated
+    assert trims >= 1
+    assert abs(agent.human.neutral[2] - start[2]) > 0.02  # the rudder was trimmed
+    assert np.allclose(agent.pilot.neutral[1:], agent.human.neutral[1:], atol=1e-9)
+    env.close()
+
+
+def test_the_pilot_leads_a_moving_reading_by_part_of_its_delay(monkeypatch):
+    # the altimeter unwinds a foot a frame: what the pilot acts on lags it, by less than its
+    # reaction time (it leads the needle), and by all of it without the lead
+    import dataclasses
+
+    from gymfg_il.display.readings import Display, display_of
+    from gymfg_il.envs.options import FlightOptions
+    from gymfg_il.manual import synthetic
+    from gymfg_il.rollout.agents import AgentSpec
+
+    env = FlightOptions(task="altitude", agent_hz=30).flight().make_env()
+    env.reset(seed=3)
+    first = display_of(env.task, env.world.slots[0].state, 0)
+    env.close()
+
+    def lag(anticipate):
+        monkeypatch.setattr(synthetic, "ANTICIPATE", anticipate)
+        pilot = AgentSpec.synthetic("keyboard", 0.7).make(env).pilot
+        pilot.skill = dataclasses.replace(pilot.skill, perception=0.0)
+        pilot.reset(3)
+        at = pilot.intent.names.index("altitude_ft")
+        for frame in range(60):
+            now = first["altitude_ft"] + frame
+            shown = [dataclasses.replace(r, value=now) if r.name == "altitude_ft" else r for r in first]
+            seen = pilot._perceive(Display(tuple(shown)))
+        return now - seen[at]  # in frames
+
+    delay = round(Skill.of(0.7).reaction_s * 30)
+    assert lag(0.0) == pytest.approx(delay - 1)
+    assert lag(0.5) == pytest.approx(delay - 1 - 0.5 * delay)
+    assert 0 < lag(0.5) < lag(0.0)
