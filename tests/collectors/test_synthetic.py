@@ -125,30 +125,32 @@ def test_the_pilot_trims_out_a_held_rudder_and_knows_where_its_trim_is():
     env.close()
 
 
-def test_the_pilot_leads_a_moving_reading_by_part_of_its_delay(monkeypatch):
-    # the altimeter unwinds a foot a frame: what the pilot acts on lags it, by less than its
-    # reaction time (it leads the needle), and by all of it without the lead
+def test_the_pilot_leads_a_moving_reading_by_part_of_its_delay():
+    # the altimeter unwinds a foot a frame: what a pilot with a lead acts on lags it by less
+    # than its reaction time, and without the lead by all of it
     import dataclasses
 
     from gymfg_il.display.readings import Display, display_of
     from gymfg_il.envs.options import FlightOptions
-    from gymfg_il.manual import synthetic
+    from gymfg_il.manual.perception import HANDS
     from gymfg_il.rollout.agents import AgentSpec
 
+    assert HANDS["f15"].anticipate == 0.5
     env = FlightOptions(task="altitude", agent_hz=30).flight().make_env()
     env.reset(seed=3)
     first = display_of(env.task, env.world.slots[0].state, 0)
-    env.close()
 
     def lag(anticipate):
-        monkeypatch.setattr(synthetic, "ANTICIPATE", anticipate)
         pilot = AgentSpec.synthetic("keyboard", 0.7).make(env).pilot
         pilot.skill = dataclasses.replace(pilot.skill, perception=0.0)
+        pilot.intent.hands = dataclasses.replace(pilot.intent.hands, anticipate=anticipate)
         pilot.reset(3)
         at = pilot.intent.names.index("altitude_ft")
         for frame in range(60):
             now = first["altitude_ft"] + frame
-            shown = [dataclasses.replace(r, value=now) if r.name == "altitude_ft" else r for r in first]
+            shown = [
+                dataclasses.replace(r, value=now) if r.name == "altitude_ft" else r for r in first
+            ]
             seen = pilot._perceive(Display(tuple(shown)))
         return now - seen[at]  # in frames
 
@@ -156,3 +158,4 @@ def test_the_pilot_leads_a_moving_reading_by_part_of_its_delay(monkeypatch):
     assert lag(0.0) == pytest.approx(delay - 1)
     assert lag(0.5) == pytest.approx(delay - 1 - 0.5 * delay)
     assert 0 < lag(0.5) < lag(0.0)
+    env.close()
