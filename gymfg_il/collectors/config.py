@@ -148,6 +148,9 @@ class ManualConfig(CollectConfig):
             flying through the same keyboard, joystick or mouse; it runs headless and as fast
             as the machine allows; its episodes are source=synthetic).
         skill: the synthetic pilot's level, 0 (a novice) to 1 (an ace).
+        pilot_name: who flies this session, stored with each episode (the card lists pilots,
+            ``train bc --select pilot=NAME`` picks theirs); default: ``synthetic-<skill>``
+            for the synthetic pilot, none for a person.
         pilot_view: the camera the window shows beside the instruments (``front``,
             ``chase``, or ``none``), so a person can fly without FlightGear.
         keyboard: key bindings (see ``manual.bindings.KeyboardBindings``).
@@ -161,6 +164,7 @@ class ManualConfig(CollectConfig):
     view: list[int] = field(default_factory=list, metadata={"repeat": True})
     pilot: Literal["person", "synthetic"] = "person"
     skill: float = 0.7
+    pilot_name: str | None = None
     pilot_view: Literal["front", "chase", "none"] = "front"
     keyboard: dict[str, Any] = field(default_factory=dict)
     mouse: dict[str, Any] = field(default_factory=dict)
@@ -176,6 +180,9 @@ class ManualConfig(CollectConfig):
         problems += [f"view port {p}: want 1..65535" for p in self.view if not 0 < p < 65536]
         if not 0.0 <= self.skill <= 1.0:
             problems.append(f"skill={self.skill}: want 0 (a novice) .. 1 (an ace)")
+        name = self.pilot_name
+        if name is not None and not (0 < len(name) <= 64 and name.isprintable()):
+            problems.append(f"pilot_name={name!r}: want 1-64 printable characters")
         return problems
 
 

@@ -149,6 +149,11 @@ class ManualSession:
         self.pilot = Takeover(self.human, assistant)
         self.rollout = Rollout(self.env, [self.pilot])
         self.person = person = "synthetic" if synthetic else "human"
+        named = config.pilot_name
+        self.pilot_name = (
+            named if named is not None else f"synthetic-{config.skill:g}" if synthetic else ""
+        )
+        self.marked = -1  # the log's episode that a mark would mark (-1: none to mark)
         self.source = person if assist is None else f"{self.assist_name}+{person}"
         self.help = help_lines(config.device, self.kb)
         title = f"GymFG-IL: {flight.task_label} on {self.env.aircraft.model}"
@@ -211,16 +216,24 @@ class ManualSession:
         self._flown, self._errors, self._return = [starts[0].state.copy()], [], 0.0
         self.debrief = None
         self.step_count, self.interventions = 0, 0
-        self._writer().start_episode(seed, starts, source=self.source)
+        self._writer().start_episode(seed, starts, source=self.source, pilot=self.pilot_name)
+        self.marked = -1
         self.state, self.message, self.show_help = "recording", "", False
 
     def _finish(self, outcome: str) -> None:
         writer = self._writer()
-        writer.end_episode(outcome=outcome, steps=self.step_count, interventions=self.interventions)
         gusty = self.flight.turbulence != "none"
         states, errors = np.array(self._flown), np.array(self._errors)
         dt = self.env.dt
         self.debrief = debrief(self.env.task, states, errors, dt, outcome, self._return, gusty)
+        writer.end_episode(
+            outcome=outcome,
+            steps=self.step_count,
+            interventions=self.interventions,
+            success=self.debrief.success,
+            verdict=self.debrief.detail,
+        )
+        self.marked = writer.episode
         if self.build_each:
             self.updater.request()  # the dataset follows in a helper process, off the GIL
         self.stats.saved += 1
@@ -253,6 +266,12 @@ class ManualSession:
             self.state = "paused" if self.state == "recording" else "recording"
         elif command == "takeover":
             self.pilot.toggle(self.last_action)
+        elif command.startswith("mark ") and self.state == "idle" and self.marked >= 0:
+            mark = command.split()[1]
+            self._writer().mark_episode(self.marked, mark)
+            self.message = f"episode marked {mark} by you; Space: next episode"
+            if self.build_each:
+                self.updater.request()  # the dataset shows the mark
         return True
 
     def _step(self) -> None:

@@ -15,6 +15,8 @@ COMMAND_KEYS = {
     "escape": "quit",
     "h": "help",
     "f1": "help",
+    "g": "mark success",
+    "b": "mark failure",
 }
 
 
@@ -27,6 +29,7 @@ def help_lines(device: str, kb: KeyboardBindings) -> list[str]:
     lines = [
         "SESSION  Space: start episode   E: end + save   Backspace: discard + fly again",
         "         P: pause   T: take over / hand back   Q or Esc: quit   H: this help",
+        "MARK     after an episode, your own verdict: G good (success)  |  B bad (failure)",
     ]
     if device == "mouse":
         lines.append("STICK    the mouse pointer (offset from the window centre)")

@@ -99,6 +99,35 @@ def _counted(values: list[Any]) -> str:
     )
 
 
+def _verdicts(success: list[Any]) -> str:
+    """How many episodes the task's own judge passed (``gymfg/success``: 1, 0, -1)."""
+    judged = [int(v) for v in success if int(v) >= 0]
+    if not judged:
+        return "not recorded"
+    unjudged = len(success) - len(judged)
+    return f"{sum(judged)} of {len(judged)} succeeded by the task's own judge" + (
+        f"; {unjudged} not judged" if unjudged else ""
+    )
+
+
+def _pilots(episodes: dict[str, list[Any]]) -> str:
+    """Each named pilot's episodes and successes (``gymfg/pilot``, ``gymfg/success``)."""
+    names = episodes.get("gymfg/pilot", [])
+    success = episodes.get("gymfg/success", [-1] * len(names))
+    flown: dict[str, list[int]] = {}
+    for name, ok in zip(names, success, strict=True):
+        if name:
+            flown.setdefault(str(name), []).append(int(ok))
+    return (
+        "; ".join(
+            f"{name}: {len(oks)} episode{'s' * (len(oks) != 1)}, "
+            f"{sum(o == 1 for o in oks)} succeeded"
+            for name, oks in sorted(flown.items())
+        )
+        or "not named"
+    )
+
+
 def episode_columns(root: Path) -> dict[str, list[Any]]:
     """The ``gymfg/*`` columns of every episode, in file order, read with pyarrow alone
     (LeRobot's loader of the episode table costs ~1 s on a 20-episode dataset)."""
@@ -155,6 +184,9 @@ def _facts(meta: Any, episodes: dict[str, list[Any]], specs: list[Any]) -> list[
         ("weather", "; ".join(sorted(weather)) or "unknown"),
         ("starts", ", ".join(sorted(starts)) or "unknown"),
         ("episode ends", _counted(ends) if ends else "not recorded"),
+        ("verdicts", _verdicts(episodes.get("gymfg/success", []))),
+        ("pilots", _pilots(episodes)),
+        ("pilots' marks", _counted(episodes.get("gymfg/mark", [])).replace("unknown", "none")),
         ("rates", f"{meta.fps} fps (agent steps); JSBSim at {sim_hz} Hz"),
         ("episodes", f"{meta.total_episodes} ({meta.total_frames} frames)"),
         ("cameras", ", ".join(cameras) or "none"),

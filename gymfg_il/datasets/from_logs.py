@@ -98,7 +98,9 @@ def target_record(task: dict[str, Any], target: float | None) -> dict[str, Any]:
 
 def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[str, Any]:
     """The ``gymfg/*`` columns of one aircraft's episode: where it comes from and what was
-    flown (``spec``: the flight spec, JSON; ``target``: ``target_record``)."""
+    flown (``spec``: the flight spec, JSON; ``target``: ``target_record``), who flew it and
+    how it went (``pilot``; ``success``: the task's verdict, 1 or 0, -1 where it was not
+    judged, with ``verdict`` in words; ``mark``: the pilot's own, or "")."""
     start, end = episode.start, episode.end or {}
     target = episode.start_of(callsign).get("target")
     info = log.aircraft(callsign)
@@ -115,11 +117,25 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "interventions": int(episode.steps[callsign].intervention.sum()),
         "iteration": int(start.get("iteration", 0)),
         "outcome": str(end.get("outcome", "")),
+        "pilot": _text(start.get("pilot")),
+        "success": _verdict(end.get("success")),
+        "verdict": _text(end.get("verdict")),
+        "mark": episode.mark,
         "log": log.path.name,
         "log_episode": int(episode.index),
         "spec": log.spec.to_json(),
         "jsbsim": str(log.session.get("versions", {}).get("jsbsim", "")),
     }
+
+
+def _verdict(success: Any) -> int:
+    """A logged verdict as its column holds it: 1, 0, or -1 where none was logged."""
+    return 1 if success is True else 0 if success is False else -1
+
+
+def _text(value: Any, limit: int = 200) -> str:
+    """A logged string as a column holds it (a log is hostile: anything else is "")."""
+    return value[:limit] if isinstance(value, str) else ""
 
 
 def _clean_leftovers(root: Path) -> None:

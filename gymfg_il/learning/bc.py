@@ -146,12 +146,13 @@ def _train(
 def demonstrations(cfg: TrainConfig, frames: Frames | None, camera: str | None) -> Frames:
     """The frames to learn from: the dataset's (``frames``, or loaded with ``camera``'s
     frames), checked to be of one task and finite, less what a policy flew unaided."""
-    from gymfg_il.learning.data import check_tasks, load_frames
+    from gymfg_il.learning.data import check_tasks, load_frames, selected
     from gymfg_il.learning.data_checks import check_trainable
 
     if frames is None or (camera is not None and frames.camera != camera):
         frames = load_frames(cfg.dataset, camera)
     check_tasks(frames.episodes, cfg.mixed_tasks)
+    frames = selected(frames, cfg.select, cfg.dataset)
     shown = frames.demonstrated()  # of a policy's own flying, only a person's takeovers
     if len(shown) < len(frames):
         log.info(

@@ -42,6 +42,11 @@ class TrainConfig:
             variables (altitude with altitude-dynamic, say). Without it a dataset of several
             tasks is refused, naming each task's episodes; tasks that observe different
             variables are refused either way.
+        select: train only on the episodes that meet every one of these: ``success`` or
+            ``failure`` (the task's verdict, stored as each episode was collected),
+            ``mark=success`` or ``mark=failure`` (the pilot's own mark), ``pilot=NAME``
+            (``collect manual --pilot-name``), ``source=NAME`` (``human``,
+            ``synthetic``, ``autopilot``, ...). Example: ``--select success pilot=ann``.
         threads: CPU threads torch uses on cpu (0 = torch's own choice; default: the policy
             type's, 1, or 0 for vision, whose convolutions gain from more).
     """
@@ -58,6 +63,7 @@ class TrainConfig:
     device: str = "cpu"
     obs_noise: float = 0.0
     mixed_tasks: bool = False
+    select: list[str] = field(default_factory=list)
     threads: int | None = None
 
     def __post_init__(self) -> None:
@@ -88,6 +94,7 @@ class TrainConfig:
             problems.append(f"val_fraction={self.val_fraction} must lie in [0, 1)")
         if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
             problems.append(f"device={self.device!r}: use cpu, cuda, cuda:N or auto")
+        problems += [selection_problem(term) for term in self.select if selection_problem(term)]
         if problems:
             raise ConfigError(join_problems("train config", problems))
 
@@ -95,6 +102,25 @@ class TrainConfig:
     def threads_wanted(self) -> int:
         """The CPU threads to train with: ``threads``, else the policy type's default."""
         return self.threads if self.threads is not None else self.policy.default_threads
+
+
+SELECT_KEYS = {"mark": ("success", "failure"), "pilot": None, "source": None}
+
+
+def selection_problem(term: str) -> str:
+    """What is wrong with one ``select`` term, or ""."""
+    if term in ("success", "failure"):
+        return ""
+    key, eq, value = term.partition("=")
+    if eq and key in SELECT_KEYS and value:
+        allowed = SELECT_KEYS[key]
+        if allowed is None or value in allowed:
+            return ""
+        return f"select {term!r}: {key}= takes {' or '.join(allowed)}"
+    return (
+        f"select {term!r}: want success, failure, mark=success, mark=failure, pilot=NAME "
+        "or source=NAME"
+    )
 
 
 def default_epochs(frames: Any) -> int:

@@ -86,6 +86,32 @@ class Frames:
         )
 
 
+def selected(frames: Frames, terms: list[str], where: Path | str) -> Frames:
+    """The episodes of ``frames`` that meet every ``terms`` (``TrainConfig.select``)."""
+    if not terms:
+        return frames
+    eps = frames.episodes
+    ids = eps.get("episode_index", list(range(len(eps.get("gymfg/seed", [])))))
+    keep = np.ones(len(ids), dtype=bool)
+    for term in terms:
+        key, _, value = term.partition("=")
+        column = {"success": "success", "failure": "success"}.get(key, key)
+        values = eps.get(f"gymfg/{column}")
+        if values is None or len(values) != len(ids):
+            raise ConfigError(
+                f"{where} records no gymfg/{column} per episode (collected before it was "
+                f"stored, or by a collector that does not store it), so --select {term} "
+                "cannot choose; drop it"
+            )
+        if key in ("success", "failure"):
+            keep &= np.array([int(v) == (key == "success") for v in values])
+        else:
+            keep &= np.array([str(v) == value for v in values])
+    if not keep.any():
+        raise ConfigError(f"--select {' '.join(terms)}: no episode of {where} meets it")
+    return frames.select(np.asarray(ids)[keep])
+
+
 def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
     """The solo flight every episode (``gymfg/*`` columns) was flown as (a team run's
     aircraft on its own; the longest episode time where only that differs), and why there is

@@ -17,6 +17,7 @@ from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import GymFGError
 from gymfg_il.recording.mcap_walk import Damage, magic_damage
 from gymfg_il.recording.messages import Sorter, stream
+from gymfg_il.recording.schemas import MARKS
 from gymfg_il.recording.session import spec_of, upgrade
 from gymfg_il.rollout.records import OpponentView
 from gymfg_il.sim.properties import ACTION_NAMES, NAMES
@@ -66,6 +67,7 @@ class LoggedEpisode:
     start: dict[str, Any]
     end: dict[str, Any] | None = None
     discarded: bool = False
+    mark: str = ""  # the pilot's own mark after it ended: success, failure, or none
     steps: dict[str, AircraftSteps] = field(default_factory=dict)
     raw_views: dict[str, list[Any]] = field(default_factory=dict, repr=False)
 
@@ -225,6 +227,8 @@ def _episodes(seen: Sorter) -> list[LoggedEpisode]:
             episodes[k].end = ev
         elif k in episodes and ev["event"] == "discard":
             episodes[k].discarded = True
+        elif k in episodes and ev["event"] == "mark" and ev.get("mark") in MARKS:
+            episodes[k].mark = str(ev["mark"])
     for (k, callsign), msgs in seen.rows.items():
         if k in episodes:
             episodes[k].steps[callsign] = _steps(msgs, seen.states.get((k, callsign), []))

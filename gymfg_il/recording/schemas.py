@@ -71,11 +71,13 @@ STATE = {
     },
 }
 
+MARKS = ("success", "failure")  # what a pilot may mark an ended episode
+
 EPISODE_EVENT = {
     "title": "gymfg.EpisodeEvent",
     "type": "object",
     "properties": {
-        "event": {"type": "string", "enum": ["start", "end", "discard"]},
+        "event": {"type": "string", "enum": ["start", "end", "discard", "mark"]},
         "episode": {"type": "integer"},
         "seed": {"type": "integer"},
         "aircraft": {
@@ -86,6 +88,14 @@ EPISODE_EVENT = {
         "steps": {"type": "integer"},
         "source": {"type": "string"},
         "interventions": {"type": "integer"},
+        "pilot": {"type": "string", "description": "start: who flew (--pilot-name)"},
+        "success": {"type": "boolean", "description": "end: the task's verdict"},
+        "verdict": {"type": "string", "description": "end: the verdict in words"},
+        "mark": {
+            "type": "string",
+            "enum": list(MARKS),
+            "description": "mark: the pilot's own mark of an ended episode (the last counts)",
+        },
     },
     "required": ["event", "episode"],
 }

@@ -371,6 +371,14 @@ class TrajectoryWriter:
         self._in_episode = False
         self._sync()
 
+    def mark_episode(self, episode: int, mark: str) -> None:
+        """The pilot's own mark of ended ``episode``: ``success`` or ``failure`` (the last
+        mark of an episode counts)."""
+        if mark not in schemas.MARKS:
+            raise ValueError(f"mark={mark!r}: want one of {', '.join(schemas.MARKS)}")
+        self._emit(self._events, {"event": "mark", "episode": int(episode), "mark": mark})
+        self._sync()
+
     def discard_episode(self, reason: str = "discarded") -> None:
         """Drop the episode in progress: it is logged as discarded and never becomes data."""
         self._emit(self._events, {"event": "discard", "episode": self.episode, "outcome": reason})

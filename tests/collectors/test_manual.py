@@ -2,6 +2,7 @@
 
 import os
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -314,3 +315,60 @@ def test_the_help_names_the_trim_keys():
     text = "\n".join(help_lines("keyboard", KeyboardBindings()))
     assert "TRIM" in text and "home" in text and "end" in text and "delete" in text
     assert "TRIM" not in "\n".join(help_lines("joystick", KeyboardBindings()))
+
+
+def test_verdicts_marks_and_the_pilot_reach_the_dataset_and_its_card(tmp_path):
+    script = {
+        1: [lambda: key(pygame.K_SPACE)],
+        100: [lambda: key(pygame.K_b), lambda: key(pygame.K_g)],  # the last mark counts
+        110: [lambda: key(pygame.K_SPACE)],
+        230: [lambda: key(pygame.K_q)],
+    }
+    stats = run(tmp_path, script, pilot_name="ann")
+    assert stats.saved == 2
+    frames = load_frames(tmp_path / "dataset")
+    eps = frames.episodes
+    assert eps["gymfg/pilot"] == ["ann", "ann"]
+    assert eps["gymfg/mark"] == ["success", ""]  # the second was never marked
+    # 3 s of altitude cannot hold the target for the last 10 s: the task's judge says so
+    assert eps["gymfg/success"] == [0, 0]
+    assert all(v.startswith("over the last") for v in eps["gymfg/verdict"])
+    card = (tmp_path / "dataset" / "README.md").read_text()
+    assert "| verdicts | 0 of 2 succeeded by the task's own judge |" in card
+    assert "| pilots | ann: 2 episodes, 0 succeeded |" in card
+    assert "success (1 episode)" in card
+
+
+def test_a_mark_needs_an_ended_episode(tmp_path):
+    # before any episode, and while one is flown, G and B mark nothing
+    script = {
+        0: [lambda: key(pygame.K_g)],
+        1: [lambda: key(pygame.K_SPACE)],
+        20: [lambda: key(pygame.K_b)],
+        150: [lambda: key(pygame.K_q)],
+    }
+    run(tmp_path, script)
+    eps = load_frames(tmp_path / "dataset").episodes
+    assert eps["gymfg/mark"] == [""] and eps["gymfg/pilot"] == [""]
+
+
+def test_train_selects_episodes_by_pilot_mark_and_verdict(tmp_path):
+    from gymfg_il.learning.config import TrainConfig
+    from gymfg_il.learning.data import selected
+
+    fly = {1: [lambda: key(pygame.K_SPACE)], 100: [lambda: key(pygame.K_q)]}
+    run(tmp_path, {**fly, 95: [lambda: key(pygame.K_g)]}, pilot_name="ann")
+    run(tmp_path, fly, pilot_name="bob", seed=50)  # appended (another case: not a twin)
+    frames = load_frames(tmp_path / "dataset")
+    assert frames.episodes["gymfg/pilot"] == ["ann", "bob"]
+    bob = selected(frames, ["pilot=bob"], "here")
+    assert set(bob.episode) == {1} and len(bob) == 90
+    assert set(selected(frames, ["mark=success"], "here").episode) == {0}
+    assert set(selected(frames, ["failure", "pilot=ann"], "here").episode) == {0}
+    with pytest.raises(ConfigError, match="no episode"):
+        selected(frames, ["success"], "here")
+    sample = load_frames(Path("datasets/sample-altitude-c172p/dataset"))
+    with pytest.raises(ConfigError, match="records no gymfg/pilot"):
+        selected(sample, ["pilot=ann"], "the sample")
+    with pytest.raises(ConfigError, match="mark= takes success or failure"):
+        TrainConfig(select=["mark=good"])

@@ -98,6 +98,9 @@ def test_the_pilot_who_sees_only_the_window_flies_each_maneuver(tmp_path, task, 
     session.run()
     assert session.debrief is not None
     assert session.debrief.success, session.debrief.lines
+    # the verdict is stored with the episode, the pilot named by its skill
+    episodes = load_frames(tmp_path / "dataset").episodes
+    assert episodes["gymfg/success"] == [1] and episodes["gymfg/pilot"] == ["synthetic-0.7"]
 
 
 def test_the_pilot_trims_out_a_held_rudder_and_knows_where_its_trim_is():

@@ -96,3 +96,26 @@ def test_a_broken_dataset_is_set_aside_and_rebuilt(built, tmp_path):
     report = build_from_logs([result.log], root)
     assert report.rebuilt and report.total_episodes == 3
     assert list(tmp_path.glob("dataset.broken-*"))
+
+
+def test_verdict_pilot_and_mark_columns_take_only_what_they_hold(built):
+    import dataclasses
+
+    from gymfg_il.datasets.from_logs import episode_metadata
+
+    out, result, _ = built
+    log = read_log(result.log)
+    episode = log.episodes[0]
+    callsign = next(iter(episode.steps))
+    plain = episode_metadata(log, episode, callsign)
+    # the autopilot's collector does not judge its episodes (yet): -1, not a guess
+    assert (plain["success"], plain["verdict"], plain["pilot"], plain["mark"]) == (-1, "", "", "")
+    hostile = dataclasses.replace(
+        episode,
+        start={**episode.start, "pilot": ["not", "a", "name"]},
+        end={**(episode.end or {}), "success": [1], "verdict": {"x": 1}},
+    )
+    columns = episode_metadata(log, hostile, callsign)
+    assert (columns["success"], columns["verdict"], columns["pilot"]) == (-1, "", "")
+    long = dataclasses.replace(episode, start={**episode.start, "pilot": "x" * 5000})
+    assert len(episode_metadata(log, long, callsign)["pilot"]) == 200
