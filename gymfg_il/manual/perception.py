@@ -114,7 +114,8 @@ class DisplayIntent:
         sources = DISPLAY_SOURCES.get(str(getattr(task, "name", "")), {})
         targets = dataclasses.replace(expert.targets, **sources)
         self.hands = HANDS.get(model, Hands())
-        station = tuple(g * self.hands.station for g in targets.station_gains)
+        kp, kd = targets.station_gains
+        station = (kp * self.hands.station, kd * self.hands.station)
         targets = dataclasses.replace(targets, station_gains=station)
         self.readings = reading_names(task)
         self.names = (*self.readings, *MOTION)

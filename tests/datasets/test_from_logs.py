@@ -103,7 +103,7 @@ def test_verdict_pilot_and_mark_columns_take_only_what_they_hold(built):
 
     from gymfg_il.datasets.from_logs import episode_metadata
 
-    out, result, _ = built
+    _, result, _ = built
     log = read_log(result.log)
     episode = log.episodes[0]
     callsign = next(iter(episode.steps))
