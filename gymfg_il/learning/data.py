@@ -99,9 +99,10 @@ def selected(frames: Frames, terms: list[str], where: Path | str) -> Frames:
         values = eps.get(f"gymfg/{column}")
         if values is None or len(values) != len(ids):
             raise ConfigError(
-                f"{where} records no gymfg/{column} per episode (collected before it was "
-                f"stored, or by a collector that does not store it), so --select {term} "
-                "cannot choose; drop it"
+                f"{where} records no gymfg/{column} per episode (built before it was "
+                f"stored), so --select {term} cannot choose: build it afresh from its logs "
+                "(move FOLDER/dataset aside, then python -m gymfg_il.collect recover FOLDER), "
+                "or drop --select"
             )
         if key in ("success", "failure"):
             keep &= np.array([int(v) == (key == "success") for v in values])
