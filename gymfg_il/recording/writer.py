@@ -4,9 +4,8 @@ The log is the write-ahead log of a collection session: the chunk in progress is
 flushed and fsynced at every episode boundary, so ``kill -9`` at any moment loses at most the
 episode in progress; ``recording.reader`` reads what an unfinished file holds.
 
-It takes the rollout loop's records: ``log_tick`` one step of the flight at a time (the manual
-session, a recorded team run) or ``write_episode`` a whole flown episode (collection on
-workers). Both end in the same messages.
+It takes the rollout loop's records: ``log_tick`` one step at a time (the manual session, a
+recorded team run) or ``write_episode`` a whole flown episode (collection on workers).
 """
 
 from __future__ import annotations
@@ -372,10 +371,9 @@ class TrajectoryWriter:
         self._sync()
 
     def mark_episode(self, episode: int, mark: str) -> None:
-        """The pilot's own mark of ended ``episode``: ``success`` or ``failure`` (the last
-        mark of an episode counts)."""
+        """The pilot's own mark of ended ``episode`` (``schemas.MARKS``; the last counts)."""
         if mark not in schemas.MARKS:
-            raise ValueError(f"mark={mark!r}: want one of {', '.join(schemas.MARKS)}")
+            raise ValueError(f"mark={mark!r}: want one of {schemas.MARKS}")
         self._emit(self._events, {"event": "mark", "episode": int(episode), "mark": mark})
         self._sync()
 
