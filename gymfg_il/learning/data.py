@@ -95,7 +95,7 @@ def selected(frames: Frames, terms: list[str], where: Path | str) -> Frames:
     keep = np.ones(len(ids), dtype=bool)
     for term in terms:
         key, _, value = term.partition("=")
-        column = {"success": "success", "failure": "success"}.get(key, key)
+        column = "success" if key in ("success", "failure") else key
         values = eps.get(f"gymfg/{column}")
         if values is None or len(values) != len(ids):
             raise ConfigError(

@@ -37,6 +37,11 @@ if TYPE_CHECKING:
 DEVICES = ("keyboard", "mouse", "joystick", "flightgear")
 
 
+def _index(*bound: tuple[list[str], int, float]) -> dict[str, tuple[int, float]]:
+    """key name -> (control index, direction), from (key names, index, direction) rows."""
+    return {name: (idx, sign) for names, idx, sign in bound for name in names}
+
+
 def _pg() -> Any:
     import pygame
 
@@ -80,21 +85,8 @@ class ManualController:
         self.held: set[str] = set()
         self.joysticks: dict[int, Any] = {}  # instance id -> pygame Joystick (or None)
         self.status = ""
-        self._key_of = self._index_keys()
-        self._trim_of = self._index_trims()
-        self.cockpit: CockpitReceiver | None = None
-        if device == "flightgear":
-            from gymfg_il.flightgear.cockpit import CockpitReceiver
-
-            fg = flightgear or FlightGearBindings()
-            self.cockpit = CockpitReceiver(fg.port, fg.host)
-            self.status = f"flightgear: waiting for controls on {fg.host}:{fg.port}"
-
-    def _index_keys(self) -> dict[str, tuple[int, float]]:
-        """key name -> (control index, direction)."""
         k = self.keys
-        out: dict[str, tuple[int, float]] = {}
-        for names, idx, sign in (
+        self._key_of = _index(
             (k.aileron_left, 0, -1.0),
             (k.aileron_right, 0, 1.0),
             (k.elevator_down, 1, 1.0),
@@ -103,24 +95,20 @@ class ManualController:
             (k.rudder_right, 2, 1.0),
             (k.throttle_up, 3, 1.0),
             (k.throttle_down, 3, -1.0),
-        ):
-            for name in names:
-                out[name] = (idx, sign)
-        return out
-
-    def _index_trims(self) -> dict[str, tuple[int, float]]:
-        """trim key name -> (control index, direction)."""
-        k = self.keys
-        out: dict[str, tuple[int, float]] = {}
-        for names, idx, sign in (
+        )
+        self._trim_of = _index(
             (k.trim_nose_down, 1, 1.0),
             (k.trim_nose_up, 1, -1.0),
             (k.trim_rudder_left, 2, -1.0),
             (k.trim_rudder_right, 2, 1.0),
-        ):
-            for name in names:
-                out[name] = (idx, sign)
-        return out
+        )
+        self.cockpit: CockpitReceiver | None = None
+        if device == "flightgear":
+            from gymfg_il.flightgear.cockpit import CockpitReceiver
+
+            fg = flightgear or FlightGearBindings()
+            self.cockpit = CockpitReceiver(fg.port, fg.host)
+            self.status = f"flightgear: waiting for controls on {fg.host}:{fg.port}"
 
     # -- Agent ---------------------------------------------------------------------------
     def reset(self, seed: int | None = None) -> None:

@@ -54,7 +54,7 @@ class Hands:
     anticipate: float = 0.0
 
 
-# tuned on seeds 100-115 (docs/results/cockpit.md); an aircraft not named flies with Hands()
+# tuned on seeds 100-163 (docs/results/cockpit.md); an aircraft not named flies with Hands()
 HANDS: dict[str, Hands] = {"f15": Hands(anticipate=0.5)}
 # where each task's loops take their targets from on the display (the expert's other settings
 # and gains stay); a target task's bug is named as the expert's source already
