@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pytest
+import zmq
 
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
 
@@ -48,3 +49,14 @@ def server(serve):
         return address, proc
 
     return start
+
+
+@pytest.fixture
+def zmq_ctx():
+    """A context for a test's raw sockets, destroyed (its sockets closed, nothing lingering)
+    after the test, passed or failed. A context left to the garbage collector with a socket
+    still holding an unsent message blocks in ``term()``: a test that failed that way once
+    hung the rest of a CI run, in whichever later test the collector ran."""
+    ctx = zmq.Context()
+    yield ctx
+    ctx.destroy(linger=0)

@@ -52,15 +52,14 @@ BAD_NAMES = {
 
 @pytest.mark.parametrize("where", ["team", "callsign", "aircraft model"])
 @pytest.mark.parametrize("bad", sorted(BAD_NAMES))
-def test_names_on_the_wire_are_printable_and_short(serve, where, bad):
+def test_names_on_the_wire_are_printable_and_short(serve, where, bad, zmq_ctx):
     address, _, log = serve("--mode", "open")
     name = BAD_NAMES[bad]
     team, callsign, model = (
         name if where == w else ok
         for w, ok in (("team", "red"), ("callsign", "red-1"), ("aircraft model", "c172p"))
     )
-    ctx = zmq.Context()
-    sock = dealer(ctx, address)
+    sock = dealer(zmq_ctx, address)
     try:
         reply = join(sock, team, {callsign: model})
         assert reply["type"] == "error" and reply["code"] == "malformed", reply
@@ -77,7 +76,6 @@ def test_names_on_the_wire_are_printable_and_short(serve, where, bad):
             assert reply["type"] == "error" and RULE in reply["message"]
     finally:
         sock.close(0)
-        ctx.term()
 
 
 @pytest.mark.parametrize("name", [FORGED, "red\x1b", "r" * 65, "red\u202e"])
@@ -89,18 +87,17 @@ def test_serve_refuses_a_team_name_off_the_rule(capsys, name):
         ServerConfig(secrets={name: "s3cret"})
 
 
-def test_a_central_state_never_outgrows_what_a_client_accepts(serve):
+def test_a_central_state_never_outgrows_what_a_client_accepts(serve, zmq_ctx):
     """Teams of 64 callsigns of 60 characters under 60-character names: the join that would
     make some team's central state larger than a client accepts is refused, saying so, and
     every team admitted receives its central state whole."""
     address, *_ = serve("--mode", "open", "--max-teams", "16")
-    ctx = zmq.Context()
     admitted, refusal = {}, None
     try:
         for t in range(10):
             name = f"{t}".rjust(60, "t")
             callsigns = [f"{t}-{i}".rjust(60, "c") for i in range(64)]
-            sock = dealer(ctx, address)
+            sock = dealer(zmq_ctx, address)
             reply = join(sock, name, dict.fromkeys(callsigns, "c172p"))
             admitted[sock] = (name, callsigns)
             if reply["type"] == "error":
@@ -137,7 +134,6 @@ def test_a_central_state_never_outgrows_what_a_client_accepts(serve):
     finally:
         for sock in admitted:
             sock.close(0)
-        ctx.term()
 
 
 class Squatter(threading.Thread):
@@ -211,12 +207,11 @@ SQUATS = {
 
 
 @pytest.mark.parametrize("case", sorted(SQUATS))
-def test_a_team_holds_its_name_and_callsigns_only_while_it_reports(serve, case):
+def test_a_team_holds_its_name_and_callsigns_only_while_it_reports(serve, case, zmq_ctx):
     options, (team, token, callsigns), refused = SQUATS[case]
     address, _, log = serve(*options, "--timeout", "0.5")
     squatter = Squatter(address, team, callsigns, token)
-    ctx = zmq.Context()
-    red = dealer(ctx, address)
+    red = dealer(zmq_ctx, address)
     try:
         reply = join(red, "red", {"red-1": "c172p"}, "r")  # the squatter reports: it holds
         assert reply["type"] == "error" and refused in reply["message"], reply
@@ -230,16 +225,14 @@ def test_a_team_holds_its_name_and_callsigns_only_while_it_reports(serve, case):
     finally:
         squatter.leave_silently()
         red.close(0)
-        ctx.term()
 
 
 @pytest.mark.parametrize("on_stall", ["pause", "end"])
-def test_a_stalled_team_others_wait_for_pauses_or_ends_as_configured(serve, on_stall):
+def test_a_stalled_team_others_wait_for_pauses_or_ends_as_configured(serve, on_stall, zmq_ctx):
     """Where another team waits for its report, a silent team is kept while the waiting team
     is paused (and answers the server's waits), or the simulation ends; never dropped."""
     address, _, log = serve("--mode", "open", "--on-stall", on_stall, "--timeout", "0.5")
-    ctx = zmq.Context()
-    red, blue = dealer(ctx, address), dealer(ctx, address)
+    red, blue = dealer(zmq_ctx, address), dealer(zmq_ctx, address)
     try:
         for sock, name in ((red, "red"), (blue, "blue")):
             assert join(sock, name, {f"{name}-1": "c172p"})["type"] == "welcome"
@@ -261,4 +254,3 @@ def test_a_stalled_team_others_wait_for_pauses_or_ends_as_configured(serve, on_s
     finally:
         red.close(0)
         blue.close(0)
-        ctx.term()

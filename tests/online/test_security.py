@@ -58,19 +58,17 @@ def raw_join(sock, name, token=""):
     return decode(sock.recv(), "server")
 
 
-def test_a_team_without_a_secret_cannot_join_a_server_with_secrets(serve):
+def test_a_team_without_a_secret_cannot_join_a_server_with_secrets(serve, zmq_ctx):
     address, *_ = serve("--mode", "open", "--team", "red:r3d", "--team", "blue:blu3")
     for name, token in (("green", ""), ("green", "r3d"), ("red", ""), ("red", "blu3")):
         with pytest.raises(ServerError, match="unauthorised"):
             fly(address, name, 1, token)
-    ctx = zmq.Context()
-    sock = ctx.socket(zmq.DEALER)
+    sock = zmq_ctx.socket(zmq.DEALER)
     sock.setsockopt(zmq.RCVTIMEO, 5000)
     sock.connect(address)
     reply = raw_join(sock, "green")
     assert reply["type"] == "error" and "not on this server's list" in reply["message"]
     sock.close(0)
-    ctx.term()
     out = {}
     fly(address, "red", 3, "r3d", out)  # the listed team, with its secret
     assert out == {"red": 3}
@@ -86,29 +84,31 @@ def test_a_server_without_secrets_says_so_and_stays_on_loopback(serve):
     assert address.startswith("tcp://0.0.0.0:")
 
 
-def test_fixed_slots_are_freed_and_every_simulation_takes_new_teams(serve):
-    address, *_ = serve("--mode", "fixed", "--teams", "2", "--timeout", "1")
-    ctx = zmq.Context()
-    squatters = [ctx.socket(zmq.DEALER) for _ in range(2)]
+def test_fixed_slots_are_freed_and_every_simulation_takes_new_teams(serve, zmq_ctx):
+    # the squatters hold their slots for the 4 s timeout: long enough for the third's join
+    # to find them held on a busy machine (1 s failed in CI)
+    address, *_ = serve("--mode", "fixed", "--teams", "2", "--timeout", "4")
+    squatters = [zmq_ctx.socket(zmq.DEALER) for _ in range(2)]
+    started = time.monotonic()
     for i, sock in enumerate(squatters):
         sock.setsockopt(zmq.RCVTIMEO, 5000)
         sock.connect(address)
         assert raw_join(sock, f"squat{i}")["type"] == "welcome"  # and never report
-    third = ctx.socket(zmq.DEALER)
+    third = zmq_ctx.socket(zmq.DEALER)
     third.setsockopt(zmq.RCVTIMEO, 5000)
     third.connect(address)
-    assert raw_join(third, "red")["code"] == "full"
-    # the squatters' slots are freed after the 1 s timeout
+    reply = raw_join(third, "red")
+    assert reply["code"] == "full", (reply, f"{time.monotonic() - started:.1f} s after the joins")
+    # the squatters' slots are freed after the timeout
     wait_until(lambda: raw_join(third, "red")["type"] == "welcome", "a slot freed")
     assert fly_together(address, ["red", "blue"], 5) == {"red": 5, "blue": 5}
     # red completes (its episode ends): the simulation ends and the roster with it
     assert fly_together(address, ["green", "yellow"], 5) == {"green": 5, "yellow": 5}
     for sock in [*squatters, third]:
         sock.close(0)
-    ctx.term()
 
 
-def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve):
+def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve, zmq_ctx):
     address, proc, err = serve("--mode", "open", "--max-teams", "8", "--timeout", "2")
 
     def rss_kb():
@@ -116,8 +116,7 @@ def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve):
         return int(re.search(r"VmRSS:\s+(\d+)", status).group(1))
 
     before = rss_kb()
-    ctx = zmq.Context()
-    sock = ctx.socket(zmq.DEALER)
+    sock = zmq_ctx.socket(zmq.DEALER)
     sock.setsockopt(zmq.RCVTIMEO, 5000)
     sock.connect(address)
     started = time.monotonic()
@@ -138,7 +137,6 @@ def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve):
     assert decode(sock.recv(), "server")["code"] == "malformed"
     assert err.read_text().count("refused a message") <= 6
     sock.close(0)
-    ctx.term()
 
 
 def test_a_team_waiting_for_the_others_hears_why_instead_of_timing_out(serve, caplog):
@@ -165,15 +163,14 @@ def test_a_team_waiting_for_the_others_hears_why_instead_of_timing_out(serve, ca
     assert out == {"red": 3, "blue": 3}
 
 
-def test_a_team_completing_at_its_first_report_ends_only_that_simulation(serve):
+def test_a_team_completing_at_its_first_report_ends_only_that_simulation(serve, zmq_ctx):
     """k-fixed: a team that reports done at its first report ends the simulation as it
     starts; the other team joins the next one instead of failing at its first step."""
     address, *_ = serve("--mode", "fixed", "--teams", "2")
     out = {}
     red = threading.Thread(target=fly, args=(address, "red", 3, "", out), daemon=True)
     red.start()
-    ctx = zmq.Context()
-    rogue = ctx.socket(zmq.DEALER)
+    rogue = zmq_ctx.socket(zmq.DEALER)
     rogue.setsockopt(zmq.RCVTIMEO, 20_000)
     rogue.connect(address)
     assert raw_join(rogue, "blue")["type"] == "welcome"
@@ -186,7 +183,6 @@ def test_a_team_completing_at_its_first_report_ends_only_that_simulation(serve):
             rogue.send(encode({"type": "alive", "team": "blue"}))
     assert reply["done"] and reply["reason"] == "team blue completed"
     rogue.close(0)
-    ctx.term()
     blue = threading.Thread(target=fly, args=(address, "blue", 3, "", out), daemon=True)
     blue.start()
     for thread in (red, blue):
