@@ -232,6 +232,7 @@ class ManualSession:
             interventions=self.interventions,
             success=self.debrief.success,
             verdict=self.debrief.detail,
+            grade=self.debrief.grade,
         )
         self.marked = writer.episode
         if self.build_each:

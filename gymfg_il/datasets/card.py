@@ -26,6 +26,7 @@ from typing import Any
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.provenance import PREFIX
 from gymfg_il.sim.properties import ACTION_NAMES, BY_NAME, NAMES
+from gymfg_il.tasks.grades import GRADES, rank
 
 CARD = "README.md"
 PACKAGE = "gymfg-il"
@@ -110,19 +111,29 @@ def _verdicts(success: list[Any]) -> str:
     )
 
 
+def _grades(grades: list[Any]) -> str:
+    """How many episodes earned each grade (``gymfg/grade``), best first."""
+    counts = Counter(str(g) for g in grades if rank(g) >= 0)
+    said = ", ".join(f"{counts[g]} {g}" for g in GRADES if counts[g])
+    return said or "not recorded"
+
+
 def _pilots(episodes: dict[str, list[Any]]) -> str:
-    """Each named pilot's episodes and successes (``gymfg/pilot``, ``gymfg/success``)."""
+    """Each named pilot's episodes, successes and grades (``gymfg/pilot``, ``gymfg/success``,
+    ``gymfg/grade``)."""
     names = episodes.get("gymfg/pilot", [])
     success = episodes.get("gymfg/success", [-1] * len(names))
-    flown: dict[str, list[int]] = {}
-    for name, ok in zip(names, success, strict=True):
+    grades = episodes.get("gymfg/grade", [""] * len(names))
+    flown: dict[str, list[tuple[int, str]]] = {}
+    for name, ok, graded in zip(names, success, grades, strict=True):
         if name:
-            flown.setdefault(str(name), []).append(int(ok))
+            flown.setdefault(str(name), []).append((int(ok), str(graded)))
     return (
         "; ".join(
-            f"{name}: {len(oks)} episode{'s' * (len(oks) != 1)}, "
-            f"{sum(o == 1 for o in oks)} succeeded"
-            for name, oks in sorted(flown.items())
+            f"{name}: {len(eps)} episode{'s' * (len(eps) != 1)}, "
+            f"{sum(ok == 1 for ok, _ in eps)} succeeded"
+            + (f" ({_grades([g for _, g in eps])})" if any(rank(g) >= 0 for _, g in eps) else "")
+            for name, eps in sorted(flown.items())
         )
         or "not named"
     )
@@ -185,6 +196,7 @@ def _facts(meta: Any, episodes: dict[str, list[Any]], specs: list[Any]) -> list[
         ("starts", ", ".join(sorted(starts)) or "unknown"),
         ("episode ends", _counted(ends) if ends else "not recorded"),
         ("verdicts", _verdicts(episodes.get("gymfg/success", []))),
+        ("grades", _grades(episodes.get("gymfg/grade", []))),
         ("pilots", _pilots(episodes)),
         ("pilots' marks", _counted(episodes.get("gymfg/mark", [])).replace("unknown", "none")),
         ("rates", f"{meta.fps} fps (agent steps); JSBSim at {sim_hz} Hz"),

@@ -43,6 +43,7 @@ from gymfg_il.datasets.verify import differences, digest
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views, episode_frames, image_key
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import Log, LoggedEpisode
+from gymfg_il.tasks.grades import rank
 from gymfg_il.viz.camera import Camera
 
 log = logging.getLogger(__name__)
@@ -100,7 +101,8 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
     """The ``gymfg/*`` columns of one aircraft's episode: where it comes from and what was
     flown (``spec``: the flight spec, JSON; ``target``: ``target_record``), who flew it and
     how it went (``pilot``; ``success``: the task's verdict, 1 or 0, -1 where it was not
-    judged, with ``verdict`` in words; ``mark``: the pilot's own, or "")."""
+    judged, with ``verdict`` in words; ``grade``: the task's (``tasks.grades``), or "";
+    ``mark``: the pilot's own, or "")."""
     start, end = episode.start, episode.end or {}
     target = episode.start_of(callsign).get("target")
     info = log.aircraft(callsign)
@@ -120,6 +122,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "pilot": _text(start.get("pilot")),
         "success": _verdict(end.get("success")),
         "verdict": _text(end.get("verdict")),
+        "grade": str(end["grade"]) if rank(end.get("grade")) >= 0 else "",
         "mark": episode.mark,
         "log": log.path.name,
         "log_episode": int(episode.index),

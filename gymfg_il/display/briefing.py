@@ -2,11 +2,12 @@
 
 The briefing states the task in words: its goal (the first paragraph of the task's
 docstring), what counts as success (the docstring's ``Success:`` sentence, or the target
-rule of ``tasks.verdicts``) and the time. Nothing is written twice: change a task's docstring
+rule of ``tasks.verdicts``), what grades it (the ``Grade:`` sentence, with the shares of
+``tasks.grades``) and the time. Nothing is written twice: change a task's docstring
 and the briefing follows.
 
 The debrief gives the task's verdict on the flown states (``ManeuverTask.judge``, or the
-target rule), why it ended, the return and the main error.
+target rule), its grade (``tasks.grades``), why it ended, the return and the main error.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.sim.properties import BY_NAME
+from gymfg_il.tasks.grades import GRADES, SHARES, Measure, grade, said
 from gymfg_il.tasks.verdicts import HOLD_S, allowed_error, held
 
 WIDTH = 84  # characters per line of the window's text panel
@@ -31,7 +33,7 @@ def _wrap(text: str) -> list[str]:
 
 def _success(task: Any) -> str:
     doc = inspect.getdoc(type(task)) or ""
-    found = re.search(r"Success:\s*(.*?)(?:\n\s*\n|\n\s*Start|\Z)", doc, re.S)
+    found = re.search(r"Success:\s*(.*?)(?:\n\s*\n|\n\s*Start|\s*Grade:|\Z)", doc, re.S)
     if found:
         return found.group(1).strip()
     tracked = task.tracked()
@@ -50,17 +52,25 @@ def briefing(task: Any, episode_time_s: float) -> list[str]:
     doc = inspect.getdoc(type(task)) or type(task).__name__
     goal = doc.split("\n\n")[0]
     lines = [f"TASK: {task.name}", *_wrap(goal), *_wrap("Success: " + _success(task))]
+    graded = re.search(r"Grade:\s*(.*?)(?:\n\s*\n|\n\s*Start|\Z)", doc, re.S)
+    if graded:
+        lines += _wrap(
+            f"Grade: {graded.group(1).strip()} Excellent when each is within "
+            f"{SHARES[0]:.0%} of its tolerance (RMS), good within {SHARES[1]:.0%}."
+        )
     lines.append(f"Time: {episode_time_s:g} s. The targets are the magenta bugs; the panel guides.")
     return lines
 
 
 @dataclass(frozen=True)
 class Debrief:
-    """The verdict of one flown episode, and the lines that say it."""
+    """The verdict of one flown episode, its grade (``tasks.grades.GRADES``), and the lines
+    that say them."""
 
     success: bool
     detail: str
     lines: tuple[str, ...]
+    grade: str = GRADES[3]
 
 
 def debrief(
@@ -78,28 +88,37 @@ def debrief(
     ``crashed``, ``ended by the pilot``)."""
     terminated = ended not in ("time limit", "ended by the pilot")
     judge = getattr(task, "judge", None)
+    measures: tuple[Measure, ...] = ()
     if terminated:
         success, detail = False, ended
     elif judge is not None and getattr(task, "plan", None):
         verdict = judge(task.plan, states, dt)
-        success, detail = verdict.success, verdict.detail
+        success, detail, measures = verdict.success, verdict.detail, verdict.measures
     else:
-        success, detail = _held(task, errors, dt, gusty)
+        success, detail, measures = _held(task, errors, dt, gusty)
+    graded = grade(success, measures)
     head = ("SUCCESS: " if success else "FAILED: ") + detail
     lines = [*_wrap(head), f"ended: {ended}; return {total_return:.1f}; {len(errors)} steps"]
-    return Debrief(success, detail, tuple(lines))
+    lines += _wrap(f"grade: {graded}" + (f" ({said(measures)})" if measures else ""))
+    return Debrief(success, detail, tuple(lines), graded)
 
 
-def _held(task: Any, errors: np.ndarray, dt: float, gusty: bool) -> tuple[bool, str]:
+def _held(
+    task: Any, errors: np.ndarray, dt: float, gusty: bool
+) -> tuple[bool, str, tuple[Measure, ...]]:
     tracked = task.tracked()
     if not tracked:
-        return True, "flown to the end"
+        return True, "flown to the end", ()
     if not len(errors):
-        return False, "no step flown"
+        return False, "no step flown", ()
     ok = held(errors, tracked["tolerance"], tracked["dynamic"], dt, gusty)
     last = np.abs(errors[-max(1, round(HOLD_S / dt)) :])
-    unit = BY_NAME[tracked["variable"]].unit
-    return ok, (
-        f"over the last {HOLD_S:g} s the error was {last.mean():.1f} {unit} on average, "
-        f"at most {last.max():.1f} {unit}"
+    variable = BY_NAME[tracked["variable"]]
+    allowed = allowed_error(tracked["tolerance"], tracked["dynamic"])
+    measure = Measure.of(variable.description, variable.unit, last, allowed)
+    return (
+        ok,
+        f"over the last {HOLD_S:g} s the error was {last.mean():.1f} {variable.unit} on "
+        f"average, at most {last.max():.1f} {variable.unit}",
+        (measure,),
     )

@@ -43,7 +43,9 @@ class TensorBatches:
     ``(inputs, action)``, where ``inputs`` is the observations (or, for a window with camera
     frames, ``(frames, observations)``) and each has a time axis where the window gives
     offsets for it. Actions outside a sample's stretch are NaN; where the window does not
-    pad, only samples that lie whole inside a stretch are drawn."""
+    pad, only samples that lie whole inside a stretch are drawn. With ``weights`` (one per
+    frame) an epoch draws as many samples as there are, with replacement, each in proportion
+    to its frame's weight."""
 
     def __init__(
         self,
@@ -52,6 +54,7 @@ class TensorBatches:
         device: str = "cpu",
         seed: int = 0,
         window: Window | None = None,
+        weights: np.ndarray | None = None,
     ) -> None:
         import torch
 
@@ -91,14 +94,22 @@ class TensorBatches:
             )
         self.starts = torch.as_tensor(starts, device=device)
         self.generator = torch.Generator(device="cpu").manual_seed(seed)
+        self.weights = None if weights is None else torch.as_tensor(weights[starts])
 
     def __len__(self) -> int:
         return (len(self.starts) + self.batch_size - 1) // self.batch_size
 
     def __iter__(self) -> Iterator[tuple[Any, Any]]:
-        torch = self.torch
-        order = torch.randperm(len(self.starts), generator=self.generator)
-        yield from self._batches(self.starts[order.to(self.starts.device)])
+        yield from self._batches(self.order())
+
+    def order(self) -> Any:
+        """One epoch's samples as frame indices: shuffled, or drawn by weight."""
+        torch, n = self.torch, len(self.starts)
+        if self.weights is None:
+            order = torch.randperm(n, generator=self.generator)
+        else:
+            order = torch.multinomial(self.weights, n, replacement=True, generator=self.generator)
+        return self.starts[order.to(self.starts.device)]
 
     def first(self, count: int) -> Iterator[tuple[Any, Any]]:
         """The first ``count`` batches in frame order, drawing nothing from the shuffle."""

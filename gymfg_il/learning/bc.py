@@ -175,8 +175,10 @@ def _batches(
     """The training batches and the validation batches (None where there are no held-out
     episodes, or they are too short for a window)."""
     from gymfg_il.learning.batches import TensorBatches
+    from gymfg_il.learning.data import grade_weights
 
-    batches = TensorBatches(train, cfg.batch_size, device, cfg.seed, window)
+    weights = grade_weights(train, cfg.dataset) if cfg.weight == "grade" else None
+    batches = TensorBatches(train, cfg.batch_size, device, cfg.seed, window, weights)
     val_batches = None
     if val:
         try:

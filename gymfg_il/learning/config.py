@@ -11,6 +11,7 @@ from typing import Any
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.policies.configuration import PolicyConfig
 from gymfg_il.policies.configuration_mlp import MLPConfig
+from gymfg_il.tasks.grades import GRADES
 from gymfg_il.typecheck import type_problems
 
 DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
@@ -44,9 +45,15 @@ class TrainConfig:
             variables are refused either way.
         select: train only on the episodes that meet every one of these: ``success`` or
             ``failure`` (the task's verdict, stored as each episode was collected),
-            ``mark=success`` or ``mark=failure`` (the pilot's own mark), ``pilot=NAME``
+            ``mark=success`` or ``mark=failure`` (the pilot's own mark),
+            ``grade=GRADE`` (the task's grade, ``tasks.grades``: that grade or a better
+            one; excellent, good, fair, unsatisfactory), ``pilot=NAME``
             (``collect manual --pilot-name``), ``source=NAME`` (``human``,
             ``synthetic``, ``autopilot``, ...). Example: ``--select success pilot=ann``.
+        weight: ``grade``: draw each episode's samples in proportion to its grade's weight
+            (``GRADE_WEIGHTS``: excellent 4, good 3, fair 2, unsatisfactory 1), so better
+            demonstrations teach more and worse ones still count; "" (default): every
+            sample alike.
         threads: CPU threads torch uses on cpu (0 = torch's own choice; default: the policy
             type's, 1, or 0 for vision, whose convolutions gain from more).
     """
@@ -64,6 +71,7 @@ class TrainConfig:
     obs_noise: float = 0.0
     mixed_tasks: bool = False
     select: list[str] = field(default_factory=list)
+    weight: str = ""
     threads: int | None = None
 
     def __post_init__(self) -> None:
@@ -95,6 +103,8 @@ class TrainConfig:
         if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
             problems.append(f"device={self.device!r}: use cpu, cuda, cuda:N or auto")
         problems += [selection_problem(term) for term in self.select if selection_problem(term)]
+        if self.weight not in ("", "grade"):
+            problems.append(f"weight={self.weight!r}: want grade, or leave it out")
         if problems:
             raise ConfigError(join_problems("train config", problems))
 
@@ -104,7 +114,8 @@ class TrainConfig:
         return self.threads if self.threads is not None else self.policy.default_threads
 
 
-SELECT_KEYS = {"mark": ("success", "failure"), "pilot": None, "source": None}
+SELECT_KEYS = {"mark": ("success", "failure"), "grade": GRADES, "pilot": None, "source": None}
+GRADE_WEIGHTS = dict(zip(GRADES, (4.0, 3.0, 2.0, 1.0), strict=True))  # ``TrainConfig.weight``
 
 
 def selection_problem(term: str) -> str:
@@ -118,8 +129,8 @@ def selection_problem(term: str) -> str:
             return ""
         return f"select {term!r}: {key}= takes {' or '.join(allowed)}"
     return (
-        f"select {term!r}: want success, failure, mark=success, mark=failure, pilot=NAME "
-        "or source=NAME"
+        f"select {term!r}: want success, failure, mark=success, mark=failure, grade=GRADE, "
+        "pilot=NAME or source=NAME"
     )
 
 

@@ -17,6 +17,7 @@ from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.videos import decode_camera, image_key
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, MixedTasksError, join_problems
+from gymfg_il.learning.config import GRADE_WEIGHTS
 from gymfg_il.learning.data_checks import (
     FEATURES,
     column_problems,
@@ -25,6 +26,7 @@ from gymfg_il.learning.data_checks import (
     rebuild_hint,
     stats_problems,
 )
+from gymfg_il.tasks.grades import rank
 
 
 @dataclass
@@ -106,11 +108,29 @@ def selected(frames: Frames, terms: list[str], where: Path | str) -> Frames:
             )
         if key in ("success", "failure"):
             keep &= np.array([int(v) == (key == "success") for v in values])
+        elif key == "grade":  # that grade or a better one
+            keep &= np.array([0 <= rank(v) <= rank(value) for v in values])
         else:
             keep &= np.array([str(v) == value for v in values])
     if not keep.any():
         raise ConfigError(f"--select {' '.join(terms)}: no episode of {where} meets it")
     return frames.select(np.asarray(ids)[keep])
+
+
+def grade_weights(frames: Frames, where: Path | str) -> np.ndarray:
+    """Each frame's sampling weight from its episode's grade (``TrainConfig.weight``)."""
+    eps = frames.episodes
+    grades = eps.get("gymfg/grade")
+    ids = eps.get("episode_index", list(range(len(grades or []))))
+    if grades is None or len(grades) != len(ids) or min(map(rank, grades), default=-1) < 0:
+        raise ConfigError(
+            f"{where}: not every episode records a grade (gymfg/grade; a dataset built before "
+            "grades were stored, or of a source nobody graded), so --weight grade cannot "
+            "weigh them: build it afresh from its logs (move FOLDER/dataset aside, then "
+            "python -m gymfg_il.collect recover FOLDER), or drop --weight"
+        )
+    by_episode = {int(i): GRADE_WEIGHTS[str(g)] for i, g in zip(ids, grades, strict=True)}
+    return np.array([by_episode[int(e)] for e in frames.episode], dtype=np.float64)
 
 
 def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:

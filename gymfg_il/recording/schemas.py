@@ -28,6 +28,7 @@ from collections.abc import Mapping
 
 from gymfg_il.recording import foxglove
 from gymfg_il.sim.properties import ACTION_NAMES, CATALOGUE
+from gymfg_il.tasks.grades import GRADES
 
 _ACTION = {
     "type": "object",
@@ -91,6 +92,11 @@ EPISODE_EVENT = {
         "pilot": {"type": "string", "description": "start: who flew (--pilot-name)"},
         "success": {"type": "boolean", "description": "end: the task's verdict"},
         "verdict": {"type": "string", "description": "end: the verdict in words"},
+        "grade": {
+            "type": "string",
+            "enum": list(GRADES),
+            "description": "end: the task's grade of the episode (gymfg_il.tasks.grades)",
+        },
         "mark": {
             "type": "string",
             "enum": list(MARKS),

@@ -16,6 +16,7 @@ from gymfg_il.aircraft import FlightProfile
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.geometry import offset_position
+from gymfg_il.tasks.grades import Measure
 from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft
 from gymfg_il.tasks.rewards import closeness
 from gymfg_il.tasks.scenery import Landmark
@@ -46,7 +47,8 @@ class WaypointsTask(ManeuverTask):
     A gate is passed within ``radius_ft`` (300) horizontally and ``altitude_tolerance_ft``
     (150) vertically, on every aircraft. Reward: ``0.5 exp(-distance / 3000) + 0.3
     exp(-|altitude error| / 150) + 0.2 exp(-|bearing error| / 20)`` minus the smoothness
-    term. Success: all three gates passed, in order.
+    term. Success: all three gates passed, in order. Grade: how far from each gate's centre
+    (of its radius) and above or below it (of its half height) the aircraft passed.
     Start and end: as every maneuver (module docstring); 120 s episodes on the c172p, times
     the aircraft's ``maneuver_scale`` (204 s on the f15, 247 on the A320).
     """
@@ -138,7 +140,7 @@ class WaypointsTask(ManeuverTask):
     def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
         north, east = local_ft(states, plan["origin"])
         alt = states[:, _ALT]
-        at = 0
+        at, off, high = 0, [], []
         for k, gate in enumerate(plan["gates"]):
             inside = np.flatnonzero(cls._inside(gate, north[at:], east[at:], alt[at:], plan))
             if not len(inside):
@@ -147,7 +149,13 @@ class WaypointsTask(ManeuverTask):
                     False, f"passed {k} of 3 gates; gate {k + 1} missed by {closest:.0f} ft"
                 )
             at += int(inside[0]) + 1  # one gate per step, as flown
-        return Verdict(True, f"all 3 gates passed, the last at {(at - 1) * dt:.1f} s")
+            off.append(math.hypot(gate[0] - north[at - 1], gate[1] - east[at - 1]))
+            high.append(alt[at - 1] - gate[2])
+        measures = (
+            Measure.of("off the gate centres", "ft", off, plan["radius_ft"]),
+            Measure.of("above the gates", "ft", high, plan["altitude_tolerance_ft"]),
+        )
+        return Verdict(True, f"all 3 gates passed, the last at {(at - 1) * dt:.1f} s", measures)
 
 
 class ApproachTask(ManeuverTask):
@@ -179,7 +187,8 @@ class ApproachTask(ManeuverTask):
     exp(-|speed error| / 10)`` minus the smoothness term.
     Success: the aircraft reaches the decision height (200 ft above the threshold on the
     path), and from 2.5 NM out down to it stays within 100 ft of the glide path, 200 ft of
-    the centre line and 10 kt of the approach speed.
+    the centre line and 10 kt of the approach speed. Grade: the glide-path, centre-line
+    (localizer) and airspeed errors from 2.5 NM out to the decision height.
     Start and end: as every maneuver (module docstring); 180 s episodes on every aircraft
     (the final grows with the approach speed instead).
     """
@@ -313,4 +322,12 @@ class ApproachTask(ManeuverTask):
         worst = float(np.abs(g["airspeed"][flown][final]).max())
         if worst > cls.tolerances["airspeed"]:
             return Verdict(False, f"{worst:.1f} kt off the approach speed on final")
-        return Verdict(True, f"decision height at {reached[0] * dt:.1f} s, on the path")
+        measures = tuple(
+            Measure.of(what, unit, g[key][flown][final], cls.tolerances[what])
+            for key, what, unit in (
+                ("glidepath", "glide path", "ft"),
+                ("offset", "centre line", "ft"),
+                ("airspeed", "airspeed", "kt"),
+            )
+        )
+        return Verdict(True, f"decision height at {reached[0] * dt:.1f} s, on the path", measures)

@@ -20,6 +20,7 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX, indices
 from gymfg_il.tasks.geometry import offset_position
+from gymfg_il.tasks.grades import Measure
 from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict
 from gymfg_il.tasks.rewards import closeness
 from gymfg_il.tasks.scenery import Landmark
@@ -92,7 +93,7 @@ class FormationTask(ManeuverTask):
     aircraft.
     Reward: ``exp(-distance to the slot / 100)`` minus the smoothness term. Success: from 30
     s on, within ``tolerance_ft`` (100) of the slot at every step, and never within 50 ft of
-    the lead.
+    the lead. Grade: the distance to the slot from 30 s on.
     Start and end: as every maneuver (module docstring); 90 s episodes on the c172p, times
     the aircraft's ``maneuver_scale`` (153 s on the f15, 186 on the A320).
     """
@@ -219,4 +220,7 @@ class FormationTask(ManeuverTask):
         if held[worst] > cls.tolerance_ft:
             when = (worst + round(cls.join_s / dt)) * dt
             return Verdict(False, f"{held[worst]:.0f} ft from the slot at {when:.1f} s")
-        return Verdict(True, f"in the slot from {cls.join_s:g} s, at most {held.max():.0f} ft off")
+        measures = (Measure.of("off the slot", "ft", held, cls.tolerance_ft),)
+        return Verdict(
+            True, f"in the slot from {cls.join_s:g} s, at most {held.max():.0f} ft off", measures
+        )

@@ -65,6 +65,7 @@ _TARGET_DOC = """
     Target: {target}.
     Reward per step: ``exp(-|error| / {scale:g}) - 0.05 * mean |change of aileron, elevator,
     rudder|`` (at most 1).
+    Grade: the error over the last 10 s, of the tolerance the success rule allows.
     Start and end: as every task (module docstring).
     """
 

@@ -36,6 +36,7 @@ import numpy as np
 from gymfg_il.aircraft import REFERENCE_PROFILE, FlightProfile
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.grades import Measure, grade
 from gymfg_il.tasks.rewards import RewardContext, action_change, closeness
 from gymfg_il.units import FT_PER_DEG, wrap_180, wrap_360
 
@@ -50,6 +51,11 @@ class Verdict:
 
     success: bool
     detail: str
+    measures: tuple[Measure, ...] = ()  # the errors the grade reads (``tasks.grades``)
+
+    @property
+    def grade(self) -> str:
+        return grade(self.success, self.measures)
 
 
 def local_ft(states: np.ndarray, origin: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
@@ -178,7 +184,8 @@ class TurnTask(ManeuverTask):
     Plan: the turn (magnitude drawn from [60, 180) deg, either way) and the start altitude.
     Reward: ``0.6 exp(-|remaining| / 30) + 0.4 exp(-|altitude error| / 100)`` minus the usual
     smoothness term. Success: the altitude stays within 100 ft of the start throughout and
-    the heading is within 5 deg of the new one over the last 10 s.
+    the heading is within 5 deg of the new one over the last 10 s. Grade: the altitude error
+    throughout and the heading error over the last 10 s.
     Start and end: as every maneuver (module docstring); 90 s episodes on the c172p, times
     the aircraft's ``maneuver_scale`` (153 s on the f15, 186 on the A320).
     """
@@ -224,7 +231,11 @@ class TurnTask(ManeuverTask):
             return Verdict(
                 False, f"heading off the new one by up to {tail.max():.1f} deg at the end"
             )
-        return Verdict(True, f"turned {turned[-1]:+.0f} of {plan['turn_deg']:+.0f} deg")
+        measures = (
+            Measure.of("altitude", "ft", alt_err, cls.altitude_tolerance),
+            Measure.of("heading", "deg", tail, cls.heading_tolerance),
+        )
+        return Verdict(True, f"turned {turned[-1]:+.0f} of {plan['turn_deg']:+.0f} deg", measures)
 
 
 class ClimbTurnTask(ManeuverTask):
@@ -243,6 +254,7 @@ class ClimbTurnTask(ManeuverTask):
     Plan: an altitude change of 300-1,000 ft and a heading change of 30-90 deg, each either
     way. Reward: ``0.5 exp(-|altitude error| / 200) + 0.5 exp(-|heading error| / 10)`` minus
     the smoothness term. Success: within 50 ft and 3 deg of both over the last 10 s.
+    Grade: the altitude and heading errors over the last 10 s.
     Start and end: as every maneuver (module docstring); 90 s episodes on the c172p, times
     the aircraft's ``maneuver_scale`` (153 s on the f15, 186 on the A320).
     """
@@ -281,10 +293,15 @@ class ClimbTurnTask(ManeuverTask):
     @classmethod
     def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
         tail = states[-hold_steps(dt) :]
-        alt = np.abs(plan["altitude_ft"] - tail[:, _ALT]).max()
-        hdg = np.abs(wrap_180(plan["heading_deg"] - tail[:, _HDG])).max()
+        alt_err = plan["altitude_ft"] - tail[:, _ALT]
+        hdg_err = wrap_180(plan["heading_deg"] - tail[:, _HDG])
+        alt, hdg = np.abs(alt_err).max(), np.abs(hdg_err).max()
         ok = len(states) > hold_steps(dt) and alt <= cls.altitude_tolerance
         ok = ok and hdg <= cls.heading_tolerance
+        measures = (
+            Measure.of("altitude", "ft", alt_err, cls.altitude_tolerance),
+            Measure.of("heading", "deg", hdg_err, cls.heading_tolerance),
+        )
         return Verdict(
-            bool(ok), f"over the last {HOLD_S:g} s: up to {alt:.0f} ft, {hdg:.1f} deg off"
+            bool(ok), f"over the last {HOLD_S:g} s: up to {alt:.0f} ft, {hdg:.1f} deg off", measures
         )

@@ -333,9 +333,11 @@ def test_verdicts_marks_and_the_pilot_reach_the_dataset_and_its_card(tmp_path):
     # 3 s of altitude cannot hold the target for the last 10 s: the task's judge says so
     assert eps["gymfg/success"] == [0, 0]
     assert all(v.startswith("over the last") for v in eps["gymfg/verdict"])
+    assert eps["gymfg/grade"] == ["unsatisfactory"] * 2  # a failure's grade
     card = (tmp_path / "dataset" / "README.md").read_text()
     assert "| verdicts | 0 of 2 succeeded by the task's own judge |" in card
-    assert "| pilots | ann: 2 episodes, 0 succeeded |" in card
+    assert "| grades | 2 unsatisfactory |" in card
+    assert "| pilots | ann: 2 episodes, 0 succeeded (2 unsatisfactory) |" in card
     assert "success (1 episode)" in card
 
 

@@ -1,0 +1,86 @@
+"""Grades: the four words from a task's measured errors (``tasks.grades``), each task's
+measures from its own judge, and the briefing that says how a flight is graded."""
+
+import math
+
+import numpy as np
+import pytest
+
+from gymfg_il.display.briefing import briefing, debrief
+from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.rollout.agents import AgentSpec
+from gymfg_il.rollout.seeded import fly_many
+from gymfg_il.sim.properties import INDEX, NAMES
+from gymfg_il.tasks.grades import GRADES, Measure, grade, rank
+from gymfg_il.tasks.maneuvers import TurnTask
+
+
+def measure(share):
+    return Measure("altitude", "ft", share * 100.0, 100.0)
+
+
+@pytest.mark.parametrize(
+    ("shares", "expected"),
+    [
+        ([0.1, 0.25], "excellent"),
+        ([0.1, 0.26], "good"),
+        ([0.5], "good"),
+        ([0.2, 0.51], "fair"),
+        ([0.9], "fair"),
+        ([], "excellent"),  # nothing measured: flown to the end is all it asks
+    ],
+)
+def test_a_success_is_graded_by_its_largest_share_of_a_tolerance(shares, expected):
+    assert grade(True, [measure(s) for s in shares]) == expected
+
+
+def test_a_failure_is_unsatisfactory_and_an_unmeasured_span_is_fair():
+    assert grade(False, [measure(0.01)]) == "unsatisfactory"
+    assert grade(True, [Measure.of("heading", "deg", [], 5.0)]) == "fair"  # NaN: no span
+    assert [rank(g) for g in GRADES] == [0, 1, 2, 3]
+    assert rank("") == rank("superb") == rank(None) == -1  # as a hostile log may hold
+
+
+def test_measure_is_the_rms_error():
+    m = Measure.of("glide path", "ft", [30.0, -40.0], 100.0)
+    assert m.rms == pytest.approx(math.sqrt((900 + 1600) / 2))
+    assert m.share == pytest.approx(0.3536, abs=1e-4)
+
+
+def test_the_turns_judge_measures_what_its_success_rule_bounds():
+    n, dt = 900, 0.1
+    states = np.zeros((n, len(NAMES)))
+    states[:, INDEX["heading_deg"]] = np.minimum(np.arange(n) * 0.5, 90.0)
+    states[:, INDEX["altitude_ft"]] = 5000.0 + 40.0 * np.sin(np.arange(n) / 50.0)
+    plan = {"turn_deg": 90.0, "start_heading_deg": 0.0, "altitude_ft": 5000.0}
+    verdict = TurnTask.judge(plan, states, dt)
+    assert verdict.success
+    altitude, heading = verdict.measures
+    rms = math.sqrt(np.mean((40.0 * np.sin(np.arange(n) / 50.0)) ** 2))
+    assert (altitude.tolerance, altitude.rms) == (100.0, pytest.approx(rms))
+    assert (heading.tolerance, heading.rms) == (5.0, 0.0)
+    assert verdict.grade == "good"  # the altitude used 28 % of its tolerance
+
+
+@pytest.mark.parametrize("task", ["turn", "approach", "formation"])
+def test_an_experts_success_is_graded_from_its_measures(task):
+    flight = FlightSpec.solo("c172p", task)
+    (ep,) = fly_many(flight, AgentSpec.controller(), [4401])
+    t = ep.solo
+    env = flight.make_env()
+    env.reset(seed=4401)  # the same plan as flown
+    states = np.vstack([t.start.state[None], t.states])
+    errors = np.zeros(len(t.states))  # a maneuver's judge reads the states alone
+    judged = debrief(env.world.slots[0].task, states, errors, ep.dt, "time limit", 0.0)
+    assert judged.success and judged.grade in ("excellent", "good")
+    assert f"grade: {judged.grade} (" in " ".join(judged.lines)
+
+
+def test_the_briefing_says_how_each_task_is_graded():
+    env = FlightSpec.solo("c172p", "approach").make_env()
+    lines = " ".join(briefing(env.world.slots[0].task, 180.0))
+    success = lines[lines.index("Success:") : lines.index("Grade:")]
+    assert "localizer" in lines and "Excellent when each is within 25%" in lines
+    assert "Grade" not in success[1:]  # the success sentence stops where the grade begins
+    env = FlightSpec.solo("c172p", "altitude").make_env()
+    assert "Grade: the error over the last 10 s" in " ".join(briefing(env.world.slots[0].task, 90))
