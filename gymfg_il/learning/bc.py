@@ -153,6 +153,13 @@ def demonstrations(cfg: TrainConfig, frames: Frames | None, camera: str | None) 
         frames = load_frames(cfg.dataset, camera)
     check_tasks(frames.episodes, cfg.mixed_tasks)
     frames = selected(frames, cfg.select, cfg.dataset)
+    if not cfg.before_first_input:
+        started = frames.from_first_input()
+        if len(started) < len(frames):
+            log.info(
+                "%d frames before the pilots' first inputs are left out", len(frames) - len(started)
+            )
+        frames = started
     shown = frames.demonstrated()  # of a policy's own flying, only a person's takeovers
     if len(shown) < len(frames):
         log.info(

@@ -54,6 +54,9 @@ class TrainConfig:
             (``GRADE_WEIGHTS``: excellent 4, good 3, fair 2, unsatisfactory 1), so better
             demonstrations teach more and worse ones still count; "" (default): every
             sample alike.
+        before_first_input: also train on the frames of a person's (or the synthetic
+            pilot's) episodes before their first input; by default those are left out, as
+            hands at rest whatever the state (``Frames.from_first_input``).
         threads: CPU threads torch uses on cpu (0 = torch's own choice; default: the policy
             type's, 1, or 0 for vision, whose convolutions gain from more).
     """
@@ -72,6 +75,7 @@ class TrainConfig:
     mixed_tasks: bool = False
     select: list[str] = field(default_factory=list)
     weight: str = ""
+    before_first_input: bool = False
     threads: int | None = None
 
     def __post_init__(self) -> None:

@@ -67,6 +67,27 @@ class Frames:
         keep = ~np.isin(self.episode, assisted) | self.intervention
         return self if keep.all() else self._take(keep)
 
+    def from_first_input(self) -> Frames:
+        """Each episode a person or the synthetic pilot flew (source ``human`` or
+        ``synthetic``) from its first input on: the frame whose action first differs from the
+        episode's first. The frames before it show hands at rest whatever the state (a person
+        reading the briefing, or not yet reacting). An episode never touched is kept whole."""
+        sources = self.episodes.get("gymfg/source")
+        if not sources or not len(self):
+            return self
+        ids = self.episodes.get("episode_index", list(range(len(sources))))
+        person = [i for i, src in zip(ids, sources, strict=True) if src in ("human", "synthetic")]
+        n = len(self)
+        starts = np.r_[True, self.episode[1:] != self.episode[:-1]]  # frames run by episode
+        first = np.maximum.accumulate(np.where(starts, np.arange(n), 0))
+        moved = np.any(self.action != self.action[first], axis=1)
+        count = np.cumsum(moved)
+        before = count[first] - moved[first]  # inputs before each frame's episode
+        last = np.r_[np.flatnonzero(starts)[1:] - 1, n - 1][np.cumsum(starts) - 1]
+        touched = count[last] > before
+        keep = (count > before) | ~touched | ~np.isin(self.episode, person)
+        return self if keep.all() else self._take(keep)
+
     def select(self, episodes: np.ndarray) -> Frames:
         return self._take(np.isin(self.episode, episodes))
 

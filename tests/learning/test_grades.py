@@ -1,9 +1,11 @@
-"""Training on what is good: ``--select grade=...`` keeps that grade and better ones, and
-``--weight grade`` draws each episode's samples in proportion to its grade's weight."""
+"""Training on what is good: ``--select grade=...`` keeps that grade and better ones,
+``--weight grade`` draws each episode's samples in proportion to its grade's weight, and a
+pilot's frames before the first input are left out."""
 
 import dataclasses
 from collections import Counter
 
+import numpy as np
 import pytest
 
 from gymfg_il import train
@@ -68,3 +70,26 @@ def test_a_weighted_run_trains_and_records_its_weighting(graded, tmp_path):
     result = train_bc(cfg, frames=graded)
     assert result.train_loss[-1] < result.train_loss[0]
     assert result.meta["train"]["weight"] == "grade"
+
+
+def test_a_pilots_frames_before_the_first_input_are_left_out_unless_asked(tiny_dataset):
+    from gymfg_il.learning.bc import demonstrations
+
+    frames = load_frames(tiny_dataset)
+    n = len(frames.episodes["gymfg/source"])
+    person = dataclasses.replace(
+        frames, episodes={**frames.episodes, "gymfg/source": ["human"] * n}
+    )
+    for e in range(n):  # the first input: frame 1, and in episode 2 frame 10
+        at = np.flatnonzero(person.episode == e)
+        rest = 10 if e == 2 else 1
+        person.action[at[:rest]] = person.action[at[0]]
+        person.action[at[rest]] = person.action[at[0]] + 0.01
+    cfg = TrainConfig(dataset=tiny_dataset)
+    flown = demonstrations(cfg, person, None)
+    assert len(flown) == len(person) - (n - 1) - 10
+    assert flown.frame[flown.episode == 2][0] == 10 and flown.frame[flown.episode == 0][0] == 1
+    asked = demonstrations(dataclasses.replace(cfg, before_first_input=True), person, None)
+    assert len(asked) == len(person)
+    # another source's episodes are kept whole
+    assert len(demonstrations(cfg, frames, None)) == len(frames)
