@@ -12,6 +12,7 @@ one starts, so quitting or a crash loses nothing completed. What the window show
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -24,6 +25,7 @@ from gymfg_il.collectors.config import ManualConfig
 from gymfg_il.collectors.manual_keys import COMMAND_KEYS, help_lines
 from gymfg_il.collectors.manual_view import window_frame
 from gymfg_il.collectors.session import DATASET, check_appendable, check_out_folder
+from gymfg_il.collectors.timing import WARN_S, EpisodeTiming
 from gymfg_il.collectors.updater import DatasetUpdater
 from gymfg_il.display.briefing import Debrief, briefing, debrief
 from gymfg_il.display.readings import Display, display_of
@@ -122,6 +124,9 @@ class ManualSession:
         self.draw = not synthetic if draw is None else draw
         self.build_each = not synthetic
         self.env = flight.make_env(list(config.view) or None)
+        self.timing = EpisodeTiming(self.env.dt)  # collectors.timing, for real-time sessions
+        self._period: float | None = None  # the loop period that produced this frame
+        self._late_at = -math.inf  # when a frame last came late
         self.images, self.image_size = list(config.images), config.image_size
         names = self.env.observation_names
         check_appendable(out, names, flight.agent_hz, None, self.images, self.image_size)
@@ -216,6 +221,7 @@ class ManualSession:
         self._flown, self._errors, self._return = [starts[0].state.copy()], [], 0.0
         self.debrief = None
         self.step_count, self.interventions = 0, 0
+        self.timing = EpisodeTiming(self.env.dt)
         self._writer().start_episode(seed, starts, source=self.source, pilot=self.pilot_name)
         self.marked = -1
         self.state, self.message, self.show_help = "recording", "", False
@@ -233,6 +239,7 @@ class ManualSession:
             success=self.debrief.success,
             verdict=self.debrief.detail,
             grade=self.debrief.grade,
+            **(self.timing.record() if self.realtime else {}),
         )
         self.marked = writer.episode
         if self.build_each:
@@ -286,8 +293,20 @@ class ManualSession:
             self._errors.append(float(self.observation[self._error_at]))
         self.step_count += 1
         self.interventions += int(step.intervention)
+        if self.realtime and self._period is not None and self.timing.add(self._period):
+            self._late_at = time.perf_counter()
         if tick.done:
             self._finish(step.reason or "terminated" if step.terminated else "time limit")
+
+    @property
+    def late_warning(self) -> str:
+        """The window's warning while frames come late (``collectors.timing``), else ""."""
+        if time.perf_counter() - self._late_at > WARN_S or self.state != "recording":
+            return ""
+        return (
+            f"LATE: {self.timing.late} frame(s) came late this episode; the flight slowed "
+            "(the data stays exact)"
+        )
 
     def _draw(self) -> None:
         self.gui.draw(window_frame(self))
@@ -303,8 +322,9 @@ class ManualSession:
         try:
             while running and (max_frames is None or frame < max_frames):
                 start = time.perf_counter()
-                if last_start is not None:
-                    self.stats.periods.append(start - last_start)
+                self._period = None if last_start is None else start - last_start
+                if self._period is not None:
+                    self.stats.periods.append(self._period)
                 last_start = start
                 if self.on_frame is not None:
                     self.on_frame(frame, self)

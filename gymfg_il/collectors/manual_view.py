@@ -57,7 +57,7 @@ def window_frame(session: ManualSession) -> GuiFrame:
         time_left_s=max(0.0, steps_left * env.dt),
         status=session.state,
         pilot=session.person if session.human_flies else str(session.assist_name),
-        message=session.message or session.human.status,
+        message=session.late_warning or session.message or session.human.status,
         help_lines=session.help,
         show_help=session.show_help,
         view=view,

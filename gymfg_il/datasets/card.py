@@ -118,6 +118,26 @@ def _grades(grades: list[Any]) -> str:
     return said or "not recorded"
 
 
+def _timing(episodes: dict[str, list[Any]], shown: int = 20) -> str:
+    """The rate and jitter of each episode flown in real time (``collectors.timing``)."""
+    late = episodes.get("gymfg/late_frames", [])
+    rate = episodes.get("gymfg/rate_hz", [-1.0] * len(late))
+    jitter = episodes.get("gymfg/jitter_ms", [-1.0] * len(late))
+    timed = [(i, n, r, j) for i, (n, r, j) in enumerate(zip(late, rate, jitter, strict=True))]
+    timed = [t for t in timed if int(t[1]) >= 0]
+    if not timed:
+        return "not recorded (no episode was flown in real time)"
+    said = [f"episode {i}: {r:.1f} Hz, jitter {j:.1f} ms, {n} late" for i, n, r, j in timed]
+    more = f"; {len(said) - shown} more" if len(said) > shown else ""
+    total = sum(int(t[1]) for t in timed)
+    flagged = sum(int(t[1]) > 0 for t in timed)
+    return (
+        f"{total} late frame(s) in {flagged} of {len(timed)} real-time episodes; "
+        + "; ".join(said[:shown])
+        + more
+    )
+
+
 def _pilots(episodes: dict[str, list[Any]]) -> str:
     """Each named pilot's episodes, successes and grades (``gymfg/pilot``, ``gymfg/success``,
     ``gymfg/grade``)."""
@@ -197,6 +217,7 @@ def _facts(meta: Any, episodes: dict[str, list[Any]], specs: list[Any]) -> list[
         ("episode ends", _counted(ends) if ends else "not recorded"),
         ("verdicts", _verdicts(episodes.get("gymfg/success", []))),
         ("grades", _grades(episodes.get("gymfg/grade", []))),
+        ("timing", _timing(episodes)),
         ("pilots", _pilots(episodes)),
         ("pilots' marks", _counted(episodes.get("gymfg/mark", [])).replace("unknown", "none")),
         ("rates", f"{meta.fps} fps (agent steps); JSBSim at {sim_hz} Hz"),

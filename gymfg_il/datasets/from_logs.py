@@ -123,12 +123,25 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "success": _verdict(end.get("success")),
         "verdict": _text(end.get("verdict")),
         "grade": str(end["grade"]) if rank(end.get("grade")) >= 0 else "",
+        **_timing(end),
         "mark": episode.mark,
         "log": log.path.name,
         "log_episode": int(episode.index),
         "spec": log.spec.to_json(),
         "jsbsim": str(log.session.get("versions", {}).get("jsbsim", "")),
     }
+
+
+def _timing(end: dict[str, Any]) -> dict[str, Any]:
+    """A real-time episode's timing (``collectors.timing``): late frames, rate and jitter,
+    each -1 where the session ran as fast as it could or the log holds none."""
+    late = end.get("late_frames")
+    out: dict[str, Any] = {"late_frames": late if type(late) is int and late >= 0 else -1}
+    for key in ("rate_hz", "jitter_ms"):
+        value = end.get(key)
+        number = float(value) if isinstance(value, (int, float)) else math.nan  # a bool too
+        out[key] = number if math.isfinite(number) and number >= 0 else -1.0
+    return out
 
 
 def _verdict(success: Any) -> int:

@@ -97,6 +97,9 @@ EPISODE_EVENT = {
             "enum": list(GRADES),
             "description": "end: the task's grade of the episode (gymfg_il.tasks.grades)",
         },
+        "late_frames": {"type": "integer", "description": "end, real time: frames late"},
+        "rate_hz": {"type": "number", "description": "end, real time: frames per second"},
+        "jitter_ms": {"type": "number", "description": "end, real time: std of loop periods"},
         "mark": {
             "type": "string",
             "enum": list(MARKS),

@@ -377,3 +377,41 @@ def test_train_selects_episodes_by_pilot_mark_and_verdict(tmp_path):
         selected(older, ["pilot=ann"], "an older dataset")
     with pytest.raises(ConfigError, match="mark= takes success or failure"):
         TrainConfig(select=["mark=good"])
+
+
+def test_a_slow_loop_counts_its_late_frames_and_the_window_warns(tmp_path):
+    """In real time, frames made late by a slow loop are counted (the episode is kept), the
+    window warns while it happens, and the dataset and card give the rate and jitter."""
+    import time
+
+    seen = []
+
+    def on_frame(frame, session):
+        if frame == 1:
+            key(pygame.K_SPACE)
+        if frame in range(20, 26):
+            time.sleep(0.1)  # 3 periods at 30 Hz: late by any measure
+        if frame == 27:
+            seen.append(session.late_warning)
+        if frame == 95:  # the episode (90 frames from frame 1) has ended
+            seen.append(session.late_warning)
+            key(pygame.K_q)
+
+    session = ManualSession(manual_config(tmp_path), on_frame, realtime=True)
+    assert session.run(max_frames=200).saved == 1
+    assert seen[0].startswith("LATE: ") and seen[1] == ""  # warned while flying, not after
+    eps = load_frames(tmp_path / "dataset").episodes
+    late = eps["gymfg/late_frames"][0]
+    assert 6 <= late == session.timing.late  # a busy machine may make more late
+    # 6 frames of 133 ms among 90 of 33 ms: at most 27 Hz, the spread tens of ms
+    assert 5 < eps["gymfg/rate_hz"][0] < 27.5 and eps["gymfg/jitter_ms"][0] > 10
+    card = (tmp_path / "dataset" / "README.md").read_text()
+    assert f"| timing | {late} late frame(s) in 1 of 1 real-time episodes; episode 0: " in card
+
+
+def test_a_session_run_as_fast_as_it_can_records_no_timing(tmp_path):
+    run(tmp_path, {1: [lambda: key(pygame.K_SPACE)], 100: [lambda: key(pygame.K_q)]})
+    eps = load_frames(tmp_path / "dataset").episodes
+    assert eps["gymfg/late_frames"] == [-1] and eps["gymfg/rate_hz"] == [-1.0]
+    card = (tmp_path / "dataset" / "README.md").read_text()
+    assert "| timing | not recorded (no episode was flown in real time) |" in card
