@@ -1,8 +1,9 @@
-"""The manual session: frame timing at 30 Hz with the GUI and recording on, and how fast the
-synthetic pilot collects headless."""
+"""The manual session: frame timing at 30 Hz with the GUI and recording on, how fast the
+synthetic pilot collects headless, and how soon a real key press reaches the record."""
 
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -96,5 +97,37 @@ def synthetic_pilot(seconds: float) -> Row:
     )
 
 
+def input_to_record(presses: int) -> Row:
+    """p99 agent steps from a real X key event in a real window (Xvfb, xdotool) to the
+    recorded action (``benchmarks.latency``); NaN, saying why, without Xvfb or xdotool."""
+    import shutil
+
+    from benchmarks.latency import on_own_display
+
+    missing = [tool for tool in ("Xvfb", "xdotool") if shutil.which(tool) is None]
+    if missing:
+        detail = [f"input_to_record skipped: needs {', '.join(missing)} (apt-get install)"]
+        return Row("input_to_record_p99_steps", math.nan, "steps", 1.0, False, detail)
+    found = on_own_display(presses)
+    ms, steps = np.array(found["ms"]), np.array(found["steps"])
+    return Row(
+        "input_to_record_p99_steps",
+        float(np.percentile(steps, 99)),
+        "steps",
+        1.0,
+        higher_is_better=False,
+        detail=[
+            f"input to record, {len(ms)} real key presses at 30 Hz (Xvfb + xdotool, its start-up "
+            f"counted): p50 {np.median(ms):.1f} ms, p99 {np.percentile(ms, 99):.1f} ms; steps "
+            f"p50 {np.median(steps):g}, max {steps.max()}; {len(found['missed'])} never "
+            f"recorded, {found['late_frames']} late frames"
+        ],
+    )
+
+
 def rows(quick: bool) -> list[Row]:
-    return [manual_loop(5 if quick else 20), synthetic_pilot(10 if quick else 60)]
+    return [
+        manual_loop(5 if quick else 20),
+        synthetic_pilot(10 if quick else 60),
+        input_to_record(10 if quick else 60),
+    ]

@@ -7,8 +7,8 @@ Rows: env_step_vs_raw_jsbsim and per_aircraft_8_vs_1 (``physics``),
 dataset_build_frames_per_s and train_pipeline_frames_per_s (``data``),
 rollout_workers_vs_ceiling and ray_vs_pool_2_workers (``workers``),
 camera_frames_per_s (``camera``),
-manual_loop_p99_period_error_ms and
-synthetic_pilot_x_realtime (``manual``),
+manual_loop_p99_period_error_ms, synthetic_pilot_x_realtime and
+input_to_record_p99_steps (``manual``),
 online_{2,8,16}_teams_steps_per_s and online_2_teams_pinned_steps_per_s (``online``). Ratios
 are medians of paired rounds (see ``benchmarks.common``).
 """

@@ -5,6 +5,7 @@ import shutil
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -78,3 +79,29 @@ def test_keys_typed_into_a_real_window_become_the_dataset(display, tmp_path):
     frames = load_frames(out / "dataset")
     assert len(frames) == 120  # 4 s at 30 Hz
     assert frames.action[:, 0].min() < -0.3  # the Left key rolled the stick left
+
+
+def test_a_real_key_press_reaches_the_record_within_a_frame(display):
+    """Real X key events (xdotool) into a real window: every press is recorded, by the first
+    frame that could read it or the next (``benchmarks.latency``; the benchmark row
+    input_to_record_p99_steps measures more presses)."""
+    import json
+
+    import numpy as np
+
+    env = {**os.environ, "DISPLAY": display, "HF_HUB_OFFLINE": "1"}
+    env.pop("SDL_VIDEODRIVER", None)
+    done = subprocess.run(
+        [sys.executable, "-m", "benchmarks.latency", "12"],
+        cwd=Path(__file__).resolve().parents[2],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=DEADLINE_S,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    found = json.loads(done.stdout.strip().splitlines()[-1])
+    assert found["missed"] == []  # no press lost
+    ms, steps = np.array(found["ms"]), np.array(found["steps"])
+    assert len(ms) == 12 and np.median(steps) <= 1  # xdotool's start-up counts against us
+    assert ms.max() < 4 * found["period_ms"], ms  # a busy machine delays frames, not input
