@@ -12,6 +12,9 @@ import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.features import check_compatible, dataset_features
@@ -25,6 +28,7 @@ from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.records import Episode
 from gymfg_il.rollout.seeded import iter_many
+from gymfg_il.tasks.verdicts import judge_flight
 from gymfg_il.workers import Workers
 
 DATASET = "dataset"
@@ -141,6 +145,28 @@ class SessionResult:
         return [e.total_return for e in self.episodes]
 
 
+def judged(episode: Episode, gusty: bool) -> dict[str, Any]:
+    """A one-aircraft episode's verdict and grade as its end event stores them
+    (``tasks.verdicts.judge_flight``; nothing where it is not judged: a team's episode)."""
+    from gymfg_il.tasks.grades import grade
+
+    if len(episode.trajectories) != 1:
+        return {}
+    t = episode.solo
+    task = t.start.task
+    if t.terminated:
+        return {"success": False, "verdict": episode.outcome, "grade": grade(False, ())}
+    states = np.vstack([t.start.state[None], t.states])
+    tracked = task.get("tracked") or {}
+    names = list(task.get("observation", []))
+    at = names.index(tracked["error"]) if tracked.get("error") in names else None
+    errors = t.next_observations[:, at] if at is not None else np.zeros(0)
+    success, detail, measures = judge_flight(task, states, errors, episode.dt, gusty)
+    if success is None:
+        return {}
+    return {"success": success, "verdict": detail, "grade": grade(success, measures)}
+
+
 def record_session(
     flight: FlightSpec,
     pilot: AgentSpec,
@@ -170,7 +196,8 @@ def record_session(
     flown = iter_many(flight, pilot, seeds, workers, expert=expert, noise=noise)
     with TrajectoryWriter(new_log_path(out, source), record) as writer:
         for i, episode in enumerate(flown):
-            writer.write_episode(episode, source=source, iteration=iteration)
+            end = judged(episode, flight.turbulence != "none")
+            writer.write_episode(episode, end, source=source, iteration=iteration)
             episodes.append(episode)
             if progress is not None:
                 progress(i, episode.total_return)

@@ -22,7 +22,7 @@ import numpy as np
 
 from gymfg_il.sim.properties import BY_NAME
 from gymfg_il.tasks.grades import GRADES, SHARES, Measure, grade, said
-from gymfg_il.tasks.verdicts import HOLD_S, allowed_error, held
+from gymfg_il.tasks.verdicts import HOLD_S, allowed_error, judge_flight
 
 WIDTH = 84  # characters per line of the window's text panel
 
@@ -87,38 +87,15 @@ def debrief(
     observation) for the target rule; ``ended`` says why it ended (``time limit``,
     ``crashed``, ``ended by the pilot``)."""
     terminated = ended not in ("time limit", "ended by the pilot")
-    judge = getattr(task, "judge", None)
     measures: tuple[Measure, ...] = ()
     if terminated:
         success, detail = False, ended
-    elif judge is not None and getattr(task, "plan", None):
-        verdict = judge(task.plan, states, dt)
-        success, detail, measures = verdict.success, verdict.detail, verdict.measures
     else:
-        success, detail, measures = _held(task, errors, dt, gusty)
+        judge = getattr(task, "judge", None)
+        judged, detail, measures = judge_flight(task.describe(), states, errors, dt, gusty, judge)
+        success = bool(judged)
     graded = grade(success, measures)
     head = ("SUCCESS: " if success else "FAILED: ") + detail
     lines = [*_wrap(head), f"ended: {ended}; return {total_return:.1f}; {len(errors)} steps"]
     lines += _wrap(f"grade: {graded}" + (f" ({said(measures)})" if measures else ""))
     return Debrief(success, detail, tuple(lines), graded)
-
-
-def _held(
-    task: Any, errors: np.ndarray, dt: float, gusty: bool
-) -> tuple[bool, str, tuple[Measure, ...]]:
-    tracked = task.tracked()
-    if not tracked:
-        return True, "flown to the end", ()
-    if not len(errors):
-        return False, "no step flown", ()
-    ok = held(errors, tracked["tolerance"], tracked["dynamic"], dt, gusty)
-    last = np.abs(errors[-max(1, round(HOLD_S / dt)) :])
-    variable = BY_NAME[tracked["variable"]]
-    allowed = allowed_error(tracked["tolerance"], tracked["dynamic"])
-    measure = Measure.of(variable.description, variable.unit, last, allowed)
-    return (
-        ok,
-        f"over the last {HOLD_S:g} s the error was {last.mean():.1f} {variable.unit} on "
-        f"average, at most {last.max():.1f} {variable.unit}",
-        (measure,),
-    )

@@ -264,9 +264,8 @@ class TrajectoryWriter:
         for team, view in tick.views.items():
             self.log_view(team, tick.step, view)
 
-    def write_episode(self, episode: Episode, **info: Any) -> None:
-        """Log a whole flown episode and make it durable (``info``: source, iteration). The
-        messages come in the order ``log_tick`` would have written them."""
+    def write_episode(self, episode: Episode, end: dict | None = None, **info: Any) -> None:
+        """Log a flown episode, durably (``info``: its start event's; ``end``: its end's)."""
         trajectories = list(episode.trajectories.values())
         starts = [t.start for t in trajectories]
         self.start_episode(episode.seed, starts, episode.options, **info)
@@ -288,6 +287,7 @@ class TrajectoryWriter:
             outcome=episode.outcome,
             steps=steps,
             interventions=int(sum(t.interventions.sum() for t in trajectories)),
+            **(end or {}),
         )
 
     def log_step(

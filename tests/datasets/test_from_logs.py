@@ -9,6 +9,7 @@ from gymfg_il.collectors.config import CollectConfig
 from gymfg_il.datasets.from_logs import build_from_logs
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import read_log
+from gymfg_il.tasks.grades import GRADES
 
 os.environ["HF_HUB_OFFLINE"] = "1"
 
@@ -108,14 +109,31 @@ def test_verdict_pilot_and_mark_columns_take_only_what_they_hold(built):
     episode = log.episodes[0]
     callsign = next(iter(episode.steps))
     plain = episode_metadata(log, episode, callsign)
-    # the autopilot's collector does not judge its episodes (yet): -1, not a guess
-    assert (plain["success"], plain["verdict"], plain["pilot"], plain["mark"]) == (-1, "", "", "")
+    # the autopilot's collector judges and grades its episodes as the manual window does
+    assert plain["success"] in (0, 1) and plain["verdict"].startswith("over the last 10 s")
+    assert plain["grade"] in GRADES and (plain["success"] == 1) == (plain["grade"] != GRADES[3])
+    assert (plain["pilot"], plain["mark"], plain["late_frames"], plain["rate_hz"]) == (
+        "",
+        "",
+        -1,
+        -1,
+    )
     hostile = dataclasses.replace(
         episode,
         start={**episode.start, "pilot": ["not", "a", "name"]},
-        end={**(episode.end or {}), "success": [1], "verdict": {"x": 1}},
+        end={
+            **(episode.end or {}),
+            "success": [1],
+            "verdict": {"x": 1},
+            "grade": "superb",
+            "late_frames": True,
+            "rate_hz": float("inf"),
+            "jitter_ms": "2",
+        },
     )
     columns = episode_metadata(log, hostile, callsign)
     assert (columns["success"], columns["verdict"], columns["pilot"]) == (-1, "", "")
+    assert (columns["grade"], columns["late_frames"], columns["rate_hz"]) == ("", -1, -1.0)
+    assert columns["jitter_ms"] == -1.0
     long = dataclasses.replace(episode, start={**episode.start, "pilot": "x" * 5000})
     assert len(episode_metadata(log, long, callsign)["pilot"]) == 200

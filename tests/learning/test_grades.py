@@ -8,7 +8,6 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from gymfg_il import train
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.batches import TensorBatches
 from gymfg_il.learning.bc import train_bc
@@ -50,19 +49,23 @@ def test_weighting_draws_each_episode_in_proportion_to_its_grade(graded):
         assert drawn[e] / total == pytest.approx(expected, rel=0.05), e
 
 
-def test_weighting_needs_every_episode_graded(graded, tiny_dataset, tmp_path, capsys):
+def test_weighting_needs_every_episode_graded(graded, tmp_path):
     ungraded = dataclasses.replace(
         graded, episodes={**graded.episodes, "gymfg/grade": [*GRADED[:5], ""]}
     )
     with pytest.raises(ConfigError, match=r"not every episode records a grade.*--weight"):
-        grade_weights(ungraded, "an autopilot's dataset")
+        grade_weights(ungraded, "a team's dataset")
     with pytest.raises(ConfigError, match="weight='size': want grade"):
         TrainConfig(weight="size")
-    # the autopilot's episodes are not graded: the command says so and trains nothing
-    argv = ["bc", "--dataset", str(tiny_dataset), "--weight", "grade", "--epochs", "1"]
-    assert train.main([*argv, "--out", str(tmp_path / "p"), "--no-progress"]) == 2
-    assert "not every episode records a grade" in capsys.readouterr().err
-    assert not (tmp_path / "p").exists()
+    cfg = TrainConfig(dataset=tmp_path, out=tmp_path / "p", epochs=1, weight="grade")
+    with pytest.raises(ConfigError, match="not every episode records a grade"):
+        train_bc(cfg, frames=ungraded)
+    assert not (tmp_path / "p").exists()  # refused before anything was trained or written
+
+
+def test_the_autopilots_episodes_are_graded(tiny_dataset):
+    grades = load_frames(tiny_dataset).episodes["gymfg/grade"]
+    assert len(grades) == 6 and set(grades) <= {"excellent", "good", "fair", "unsatisfactory"}
 
 
 def test_a_weighted_run_trains_and_records_its_weighting(graded, tmp_path):
