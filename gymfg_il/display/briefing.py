@@ -55,8 +55,8 @@ def briefing(task: Any, episode_time_s: float) -> list[str]:
     graded = re.search(r"Grade:\s*(.*?)(?:\n\s*\n|\n\s*Start|\Z)", doc, re.S)
     if graded:
         lines += _wrap(
-            f"Grade: {graded.group(1).strip()} Excellent when each is within "
-            f"{SHARES[0]:.0%} of its tolerance (RMS), good within {SHARES[1]:.0%}."
+            f"Grade: {graded.group(1).strip()} Excellent when the worst of each stays within "
+            f"{SHARES[0]:.0%} of its tolerance, good within {SHARES[1]:.0%}."
         )
     lines.append(f"Time: {episode_time_s:g} s. The targets are the magenta bugs; the panel guides.")
     return lines

@@ -90,5 +90,5 @@ def judge_flight(
         ok,
         f"over the last {HOLD_S:g} s the error was {last.mean():.1f} {variable.unit} on "
         f"average, at most {last.max():.1f} {variable.unit}",
-        (Measure.of(variable.description, variable.unit, last, allowed),),
+        (Measure.of(variable.description, variable.unit, last, allowed, mean=gusty),),
     )
