@@ -97,7 +97,8 @@ def _train(
     device = resolve_device(cfg.device)
     window = cfg.policy.window
     given = frames
-    frames = demonstrations(cfg, frames, window.camera)
+    shift: dict[str, Any] = {}
+    frames = demonstrations(cfg, frames, window.camera, shift)
     flight, why = frames.flight()
     if flight is None:
         log.warning(
@@ -135,6 +136,7 @@ def _train(
         "train_loss": train_loss,
         "val_loss": val_loss,
         "seconds": seconds,
+        **shift,
     }
     meta = run_meta(cfg, name, frames, flight, why, image_size, run)
     check_diverged(policy, settings)
@@ -143,9 +145,16 @@ def _train(
     return TrainResult(out, train_loss, val_loss, seconds, len(train) * steps.epochs, meta)
 
 
-def demonstrations(cfg: TrainConfig, frames: Frames | None, camera: str | None) -> Frames:
+def demonstrations(
+    cfg: TrainConfig,
+    frames: Frames | None,
+    camera: str | None,
+    record: dict[str, Any] | None = None,
+) -> Frames:
     """The frames to learn from: the dataset's (``frames``, or loaded with ``camera``'s
-    frames), checked to be of one task and finite, less what a policy flew unaided."""
+    frames), checked to be of one task and finite, selected, shifted by the pilot's reaction
+    (``cfg.shift``: what was shifted goes into ``record``), from each pilot's first input,
+    less what a policy flew unaided."""
     from gymfg_il.learning.data import check_tasks, load_frames, selected
     from gymfg_il.learning.data_checks import check_trainable
 
@@ -153,6 +162,12 @@ def demonstrations(cfg: TrainConfig, frames: Frames | None, camera: str | None) 
         frames = load_frames(cfg.dataset, camera)
     check_tasks(frames.episodes, cfg.mixed_tasks)
     frames = selected(frames, cfg.select, cfg.dataset)
+    if cfg.shift != "0":
+        from gymfg_il.learning.reaction import shifted
+
+        frames, shift = shifted(frames, cfg.shift)
+        if record is not None:
+            record.update(shift)
     if not cfg.before_first_input:
         started = frames.from_first_input()
         if len(started) < len(frames):

@@ -54,6 +54,11 @@ class TrainConfig:
             (``GRADE_WEIGHTS``: excellent 4, good 3, fair 2, unsatisfactory 1), so better
             demonstrations teach more and worse ones still count; "" (default): every
             sample alike.
+        shift: pair each observation with the action taken this many steps later (the
+            pilot's reaction time answered for: the policy acts at once where the pilot acted
+            late), or ``auto``: each pilot's own reaction time, estimated from their
+            demonstrations (``learning.reaction``), on the episodes a person or the synthetic
+            pilot flew. Default 0.
         before_first_input: also train on the frames of a person's (or the synthetic
             pilot's) episodes before their first input; by default those are left out, as
             hands at rest whatever the state (``Frames.from_first_input``).
@@ -75,6 +80,7 @@ class TrainConfig:
     mixed_tasks: bool = False
     select: list[str] = field(default_factory=list)
     weight: str = ""
+    shift: str = "0"
     before_first_input: bool = False
     threads: int | None = None
 
@@ -107,6 +113,8 @@ class TrainConfig:
         if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
             problems.append(f"device={self.device!r}: use cpu, cuda, cuda:N or auto")
         problems += [selection_problem(term) for term in self.select if selection_problem(term)]
+        if self.shift != "auto" and not (self.shift.isdigit() and int(self.shift) <= 120):
+            problems.append(f"shift={self.shift!r}: want a number of steps (0-120) or auto")
         if self.weight not in ("", "grade"):
             problems.append(f"weight={self.weight!r}: want grade, or leave it out")
         if problems:
