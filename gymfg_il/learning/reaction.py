@@ -83,8 +83,9 @@ def reactions(frames: Frames) -> dict[str, int | None]:
     ids = eps.get("episode_index", list(range(len(eps.get("gymfg/source", [])))))
     source = dict(zip(ids, [str(s) for s in eps.get("gymfg/source", [])], strict=True))
     by_pilot: dict[str, list[int]] = {}
+    present = set(np.unique(frames.episode).tolist())  # a selection keeps every episode's row
     for e, pilot in pilot_of(frames).items():
-        if source.get(e) in PERSONS:
+        if source.get(e) in PERSONS and e in present:
             by_pilot.setdefault(pilot, []).append(e)
     return {pilot: reaction_steps(frames, found) for pilot, found in sorted(by_pilot.items())}
 

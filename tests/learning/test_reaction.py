@@ -53,6 +53,7 @@ def test_the_estimate_finds_the_lag_at_which_the_stick_answers_the_attitude():
     frames = answering([3, 3, 9, 9, 0, 0])
     assert reactions(frames) == {"lag0": 0, "lag3": 3, "lag9": 9}
     assert reaction_steps(frames, [2, 3]) == 9
+    assert reactions(frames.select(np.array([0, 1]))) == {"lag3": 3}  # the pilots selected
     # an observation without attitude, or episodes too short to tell: no estimate
     assert reaction_steps(dataclasses.replace(frames, observation_names=["a", "b", "c"])) is None
     assert (
