@@ -41,7 +41,7 @@ def main(out: Path) -> None:
         print(f"| {tier} | " + " | ".join(str(graded[(tier, g)]) for g in GRADES) + " |")
     rows = []
     for tier in TIERS:
-        pilot, controller = _rows(out / f"eval-pilot-{tier}.json")
+        pilot = json.loads((out / f"eval-pilot-{tier}.json").read_text())["rows"][1]
         rows.append(row(f"pilot {tier}", pilot))
     policies = json.loads((out / "eval-policies.json").read_text())["rows"]
     rows.append(row("controller", policies[0]))
@@ -52,11 +52,6 @@ def main(out: Path) -> None:
     for name, ok, n, mean, worst, crashed in rows:
         print(f"| {name} | {ok} of {n} | {mean:.1f} | {worst:.1f} | {crashed} |")
     _plot(rows, out / "skill_tiers.png")
-
-
-def _rows(path: Path) -> tuple[dict, dict]:
-    controller, pilot = json.loads(path.read_text())["rows"][:2]
-    return pilot, controller
 
 
 def _plot(rows: list, path: Path) -> None:
