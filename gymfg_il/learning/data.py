@@ -77,16 +77,22 @@ class Frames:
             return self
         ids = self.episodes.get("episode_index", list(range(len(sources))))
         person = [i for i, src in zip(ids, sources, strict=True) if src in ("human", "synthetic")]
-        n = len(self)
-        starts = np.r_[True, self.episode[1:] != self.episode[:-1]]  # frames run by episode
-        first = np.maximum.accumulate(np.where(starts, np.arange(n), 0))
+        first, end = episode_runs(self.episode)
         moved = np.any(self.action != self.action[first], axis=1)
         count = np.cumsum(moved)
         before = count[first] - moved[first]  # inputs before each frame's episode
-        last = np.r_[np.flatnonzero(starts)[1:] - 1, n - 1][np.cumsum(starts) - 1]
-        touched = count[last] > before
+        touched = count[end - 1] > before
         keep = (count > before) | ~touched | ~np.isin(self.episode, person)
         return self if keep.all() else self._take(keep)
+
+    def later_actions(self, steps: np.ndarray) -> Frames:
+        """Each observation paired with the action taken ``steps`` (one per frame) steps later
+        in its episode; the frames with no such action are left out."""
+        _, end = episode_runs(self.episode)
+        keep = np.arange(len(self)) + steps < end
+        out = self._take(keep)
+        out.action = self.action[np.flatnonzero(keep) + steps[keep]]
+        return out
 
     def select(self, episodes: np.ndarray) -> Frames:
         return self._take(np.isin(self.episode, episodes))
@@ -107,6 +113,16 @@ class Frames:
             None if self.images is None else self.images[keep],
             self.camera,
         )
+
+
+def episode_runs(episode: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each frame of frames that run episode by episode: the index of its episode's first
+    frame, and one past its last."""
+    n = len(episode)
+    starts = np.r_[True, episode[1:] != episode[:-1]] if n else np.zeros(0, dtype=bool)
+    first = np.maximum.accumulate(np.where(starts, np.arange(n), 0))
+    end = np.r_[np.flatnonzero(starts)[1:], n][np.cumsum(starts) - 1]
+    return first, end
 
 
 def selected(frames: Frames, terms: list[str], where: Path | str) -> Frames:

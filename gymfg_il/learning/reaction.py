@@ -108,10 +108,4 @@ def shifted(frames: Frames, shift: str) -> tuple[Frames, dict[str, Any]]:
     if not any(steps.values()):
         return frames, record
     by = np.array([steps.get(int(e), 0) for e in frames.episode])
-    starts = np.r_[True, frames.episode[1:] != frames.episode[:-1]]  # frames run by episode
-    ends = np.r_[np.flatnonzero(starts)[1:], len(by)][np.cumsum(starts) - 1]  # one past
-    keep = np.arange(len(by)) + by < ends
-    later = np.flatnonzero(keep) + by[keep]
-    out = frames._take(keep)
-    out.action = frames.action[later]
-    return out, record
+    return frames.later_actions(by), record
