@@ -1,4 +1,5 @@
-"""Shared fixtures: small factories for envs, free UDP ports, and an X server of a test's own."""
+"""Shared fixtures: small factories for envs, free UDP ports, an X server of a test's own, and
+a tiny dataset of autopilot demonstrations."""
 
 from __future__ import annotations
 
@@ -86,3 +87,19 @@ def xvfb():
     """``with xvfb("1024x768x24") as display:`` an X server of the test's own (skipped with
     the reason when Xvfb is not installed)."""
     return _xvfb
+
+
+@pytest.fixture(scope="session")
+def tiny_dataset(tmp_path_factory):
+    """Six 30-s altitude demonstrations (1,800 frames) with a little DART noise."""
+    from gymfg_il.collectors.autopilot import record_autopilot
+    from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.datasets.from_logs import build_from_logs
+
+    out = tmp_path_factory.mktemp("tiny")
+    cfg = CollectConfig(
+        task="altitude", episodes=6, episode_time_s=30, noise=0.02, seed=1000, out=out
+    )
+    result = record_autopilot(cfg)
+    build_from_logs([result.log], out / "dataset")
+    return out / "dataset"

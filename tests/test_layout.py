@@ -26,7 +26,7 @@ LAYERS = [
     {"datasets"},
     {"collectors"},
     {"learning"},
-    {"evaluation", "export"},
+    {"evaluation", "export", "rl"},
     {"cli", "collect", "train", "eval", "serve", "demo", "lerobot_env"},
 ]
 LAYER = {name: i for i, names in enumerate(LAYERS) for name in names}

@@ -181,7 +181,10 @@ def retrain_config(
     from gymfg_il.policies.factory import policy_type
 
     settings = dict(meta["policy"])
-    policy = policy_type(settings.get("type", meta["type"])).config.from_dict(settings)
+    config = policy_type(settings.get("type", meta["type"])).config
+    if config.retrains_as:  # made by RL (PPO's): trained again as the network it is
+        config = policy_type(config.retrains_as).config
+    policy = config.from_dict(settings)
     known = {f.name for f in fields(TrainConfig)} - {"policy", "dataset", "out"}
     run = {k: v for k, v in meta.get("train", {}).items() if k in known}
     return TrainConfig(**{**run, **(overrides or {})}, policy=policy, dataset=dataset, out=out)

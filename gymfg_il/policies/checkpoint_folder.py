@@ -117,6 +117,9 @@ def _flush(folder: Path) -> None:
     """The staged files on disk before the rename publishes them (else a power cut could
     leave the renamed folder with empty files)."""
     for path in folder.iterdir():
+        if path.is_dir():  # a run's log folder (PPO's TensorBoard events)
+            _flush(path)
+            continue
         with open(path, "rb") as f:
             os.fsync(f.fileno())
     _flush_folder(folder)

@@ -48,6 +48,9 @@ class PolicyConfig:
     default_threads: ClassVar[int] = 1
     # a cap on the default epochs (``learning.config.epochs_for``); None: no cap
     max_default_epochs: ClassVar[int | None] = None
+    # the type ``train bc`` (and DAgger) trains a policy of this type as, where it is not
+    # itself (a PPO policy retrains as the MLP it is); None: this type, trained by ``train bc``
+    retrains_as: ClassVar[str | None] = None
 
     def __post_init__(self) -> None:
         problems = type_problems(self) or self.problems()

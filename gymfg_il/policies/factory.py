@@ -85,6 +85,11 @@ def policy_types() -> dict[str, PolicyType]:
     return {n: _REGISTRY[n] for n in [*first, *(n for n in _REGISTRY if n not in first)]}
 
 
+def bc_types() -> dict[str, PolicyType]:
+    """The types ``train bc`` trains (``policy_types`` but those made another way, PPO's)."""
+    return {n: t for n, t in policy_types().items() if t.config.retrains_as is None}
+
+
 def policy_type(name: str) -> PolicyType:
     types = policy_types()
     if name not in types:

@@ -1,0 +1,177 @@
+"""The settings of a PPO fine-tuning run (``PPORunConfig``, ``train ppo``)."""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.sim.weather import Turbulence
+from gymfg_il.typecheck import type_problems
+
+
+@dataclass
+class PPORunConfig:
+    """PPO fine-tuning of a cloned MLP policy (stable-baselines3), or PPO from scratch.
+
+    Attributes:
+        init: the MLP policy to start from (a folder ``train bc --policy mlp`` wrote): the
+            actor starts as its network and normalisation and flies its task and aircraft;
+            left out, PPO learns from scratch (give --task and --aircraft), the comparison.
+        steps: environment steps to train for (all envs together).
+        out: where the policy goes (default: policies/ppo-<task>-<aircraft>).
+        task: the task, from scratch; with --init it must be the policy's own.
+        aircraft: the aircraft, from scratch; with --init it must be the policy's own.
+        turbulence: the air to train in: none, light, moderate or severe (default: the
+            starting policy's; a change is printed as a note).
+        wind_kt: a steady wind (knots) to train in (default: the starting policy's).
+        envs: environments sampled in parallel, one process each (0: four per CPU core, which
+            samples about twice as fast as one per core: ``benchmarks.rl``).
+        seed: seeds the envs (env k starts from seed + k), the sampling and the networks; a
+            run with the same settings repeats exactly.
+        eval_every: evaluate the policy's mean action every this many env steps.
+        eval_episodes: held-out episodes each evaluation flies (seeds eval_seed, eval_seed +
+            1, ...), the same every time, with the controller on them once.
+        eval_seed: the first held-out seed.
+        keep: which actor is saved: ``best``, the evaluation with the highest success (then
+            return), the start included, so the result never flies worse than the start on
+            these seeds; or ``last``, the actor as training left it. Judge the result on
+            other seeds (``eval --seed``).
+        rollout_steps: steps each env samples between updates (PPO's n_steps).
+        batch_size: samples per gradient step.
+        epochs: passes over each rollout per update.
+        lr: Adam learning rate of the critic.
+        actor_lr: Adam learning rate of the actor (default: lr).
+        gamma: discount.
+        gae_lambda: GAE's lambda.
+        clip_range: PPO's clip on the probability ratio.
+        target_kl: an update stops early when its KL divergence from the sampling policy
+            passes 1.5 x this (0: never).
+        exploration: how PPO explores: ``sde`` (default; stable-baselines3's generalised
+            state-dependent exploration: the noise is a linear map of the normalised
+            observation, drawn anew every sde_every steps, so the controls deviate coherently
+            for a while, which a slow aircraft's state answers) or ``gaussian`` (a new noise
+            every step).
+        sde_every: steps between new gSDE noise maps (0: one per rollout).
+        action_std: the exploration noise's starting spread in the policy's normalised action
+            units (1 = the demonstrations' spread of each control).
+        critic_warmup: env steps over which only the critic learns, the actor held, so the
+            first actor updates follow a trained value function (default: a tenth of the
+            run, at least one rollout, at most 20,000 steps).
+        success_bonus: at the end of each training episode, the task judges it as eval does,
+            and a success adds this share of the episode's steps to its return (a step's task
+            reward is at most about 1), so what PPO maximises includes what success measures
+            (0: the task's reward alone).
+        anchor: weight, at the start, of the squared distance between the actor's mean action
+            and the starting policy's (normalised units) added to PPO's loss; it decays
+            linearly to 0 over anchor_steps (0: no anchor). Not used from scratch.
+        anchor_steps: env steps over which the anchor decays (default: half the run).
+        critic: hidden widths of the critic (value network).
+        hidden: hidden widths of the actor, from scratch (with --init: the policy's own).
+        device: cpu or cuda (the networks are small: cpu is usually faster).
+    """
+
+    init: Path | None = None
+    steps: int = 1_000_000
+    out: Path | None = None
+    task: str | None = None
+    aircraft: str | None = None
+    turbulence: Turbulence | None = None
+    wind_kt: float | None = None
+    envs: int = 0
+    seed: int = 0
+    eval_every: int = 50_000
+    eval_episodes: int = 16
+    eval_seed: int = 7000
+    keep: Literal["best", "last"] = "best"
+    rollout_steps: int = 512
+    batch_size: int = 512
+    epochs: int = 10
+    lr: float = 3e-4
+    actor_lr: float | None = None
+    gamma: float = 0.99
+    gae_lambda: float = 0.95
+    clip_range: float = 0.2
+    target_kl: float = 0.02
+    exploration: Literal["sde", "gaussian"] = "sde"
+    sde_every: int = 0
+    action_std: float = 0.2
+    critic_warmup: int | None = None
+    success_bonus: float = 0.2
+    anchor: float = 1.0
+    anchor_steps: int | None = None
+    critic: list[int] = field(default_factory=lambda: [256, 256])
+    hidden: list[int] = field(default_factory=lambda: [256, 256])
+    device: str = "cpu"
+
+    def __post_init__(self) -> None:
+        typed = type_problems(self)
+        if typed:
+            raise ConfigError(join_problems("train ppo", typed))
+        problems = []
+        if self.init is None and (self.task is None or self.aircraft is None):
+            problems.append(
+                "give --init POLICY (a cloned MLP to fine-tune) or, from scratch, --task and "
+                "--aircraft"
+            )
+        positive = ("steps", "eval_every", "eval_episodes", "rollout_steps", "batch_size")
+        for name in (*positive, "epochs"):
+            if getattr(self, name) < 1:
+                problems.append(f"{name}={getattr(self, name)} must be >= 1")
+        if self.sde_every < 0:
+            problems.append(f"sde_every={self.sde_every}: want 0 (once a rollout) or more")
+        if self.envs < 0:
+            problems.append(f"envs={self.envs}: want 0 (four per core) or more")
+        if not 0 < self.lr < 1:
+            problems.append(f"lr={self.lr} must lie in (0, 1) (default 3e-4)")
+        if self.actor_lr is not None and not 0 < self.actor_lr < 1:
+            problems.append(f"actor_lr={self.actor_lr} must lie in (0, 1)")
+        for name in ("gamma", "gae_lambda"):
+            if not 0 < getattr(self, name) <= 1:
+                problems.append(f"{name}={getattr(self, name)} must lie in (0, 1]")
+        if not 0 < self.clip_range < 1:
+            problems.append(f"clip_range={self.clip_range} must lie in (0, 1)")
+        for name in ("target_kl", "anchor", "success_bonus"):
+            value = getattr(self, name)
+            if not (value >= 0 and math.isfinite(value)):
+                problems.append(f"{name}={value} must be a number >= 0")
+        if not (0 < self.action_std <= 10):
+            problems.append(f"action_std={self.action_std} must lie in (0, 10]")
+        for name in ("critic_warmup", "anchor_steps"):
+            value = getattr(self, name)
+            if value is not None and value < 0:
+                problems.append(f"{name}={value} must be >= 0 env steps")
+        if not self.critic or min(self.critic) < 1 or not self.hidden or min(self.hidden) < 1:
+            problems.append("critic and hidden must be non-empty lists of widths > 0")
+        if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
+            problems.append(f"device={self.device!r}: use cpu, cuda, cuda:N or auto")
+        if problems:
+            raise ConfigError(join_problems("train ppo", problems))
+        self.init = None if self.init is None else Path(self.init)
+
+    @property
+    def n_envs(self) -> int:
+        """The envs sampled in parallel: ``envs``, else four per CPU core."""
+        return self.envs or 4 * len(os.sched_getaffinity(0))
+
+    @property
+    def rollout(self) -> int:
+        """Env steps per update, all envs together."""
+        return self.rollout_steps * self.n_envs
+
+    @property
+    def actor_rate(self) -> float:
+        return self.lr if self.actor_lr is None else self.actor_lr
+
+    @property
+    def warmup_steps(self) -> int:
+        if self.critic_warmup is not None:
+            return self.critic_warmup
+        return min(20_000, max(self.rollout, self.steps // 10))
+
+    @property
+    def anchor_span(self) -> int:
+        return self.steps // 2 if self.anchor_steps is None else self.anchor_steps

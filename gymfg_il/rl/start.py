@@ -1,0 +1,144 @@
+"""What a PPO run starts from (``Start``): the cloned MLP named by ``--init`` (or a fresh one,
+from scratch), what its config.json says, and the flight the run trains in, with the notes
+on what differs from the policy's own flight."""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import torch
+
+from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.options import FlightOptions
+from gymfg_il.errors import ConfigError
+from gymfg_il.rl.config import PPORunConfig
+
+INIT_TYPES = ("mlp", "ppo")  # what --init takes: an MLP's network
+SCRATCH_SEEDS = (0, 1)  # the controller's flights whose statistics normalise a scratch policy
+
+
+@dataclass
+class Start:
+    """What a run starts from: the actor's module, what its config.json says, the flight the
+    run trains in, and the notes on what differs from the policy's own flight."""
+
+    module: Any
+    meta: dict[str, Any]
+    flight: FlightSpec
+    notes: list[str] = field(default_factory=list)
+
+
+def starting_policy(cfg: PPORunConfig) -> Start:
+    """The actor to start from (``cfg.init``'s, or a fresh MLP) and the flight to train in;
+    a clear error for a policy that is not an MLP or a task or aircraft not its own."""
+    if cfg.init is None:
+        return scratch_policy(cfg)
+    from gymfg_il.policies.checkpoint import load_policy, read_config
+
+    meta = read_config(cfg.init) if (cfg.init / "config.json").is_file() else None
+    if meta is None:
+        raise ConfigError(
+            f"--init {cfg.init}: not a policy of ours (no config.json); give a folder "
+            "`train bc --policy mlp` wrote"
+        )
+    kind = meta["policy"].get("type", meta["type"])
+    if kind not in INIT_TYPES:
+        raise ConfigError(
+            f"--init {cfg.init} is a {kind} policy; PPO fine-tunes MLP policies only, for now "
+            "(train one with `train bc --policy mlp`)"
+        )
+    if not meta.get("spec"):
+        raise ConfigError(
+            f"--init {cfg.init} records no flight spec (its dataset predates them): train it "
+            "again on a dataset rebuilt with `collect recover`"
+        )
+    own = FlightSpec.from_dict(meta["spec"])
+    if not own.is_solo:
+        raise ConfigError(f"--init {cfg.init} flies a team flight; PPO here trains solo flights")
+    for name, given in (("task", cfg.task), ("aircraft", cfg.aircraft)):
+        if given is not None and given != getattr(own, name):
+            raise ConfigError(
+                f"--{name} {given}: {cfg.init} flies {name} {getattr(own, name)}; fine-tuning "
+                f"keeps the policy's own {name} (drop --{name}, or start from a policy of "
+                f"{given})"
+            )
+    module, meta = load_policy(cfg.init)
+    if getattr(module.config, "dropout", 0.0):
+        raise ConfigError(
+            f"--init {cfg.init} uses dropout ({module.config.dropout}); PPO's likelihoods need "
+            "a network without it: train the MLP with --dropout 0"
+        )
+    changes = {k: v for k, v in (("turbulence", cfg.turbulence), ("wind_kt", cfg.wind_kt))}
+    notes = [
+        f"note: {cfg.init} was trained with {k}={getattr(own, k)!r}; training it with "
+        f"{k}={v!r} as asked"
+        for k, v in changes.items()
+        if v is not None and v != getattr(own, k)
+    ]
+    flight = own.replace(**{k: v for k, v in changes.items() if v is not None})
+    return Start(module, meta, flight, notes)
+
+
+def scratch_policy(cfg: PPORunConfig) -> Start:
+    """A fresh MLP for the flight ``cfg`` names, normalised by the statistics of the
+    controller's flights of ``SCRATCH_SEEDS``; its last layer starts near zero, so its first
+    actions are about the controller's mean action."""
+    from gymfg_il.policies.configuration_mlp import MLPConfig
+    from gymfg_il.policies.modeling_mlp import MLPPolicy
+    from gymfg_il.rollout.agents import AgentSpec
+    from gymfg_il.rollout.seeded import fly_many
+
+    options = FlightOptions(
+        aircraft=cfg.aircraft, task=cfg.task, turbulence=cfg.turbulence, wind_kt=cfg.wind_kt
+    )
+    flight = options.flight()
+    flown = [e.solo for e in fly_many(flight, AgentSpec.controller(), SCRATCH_SEEDS)]
+    obs = np.vstack([t.observations for t in flown])
+    act = np.vstack([t.actions for t in flown])
+    stats = [{"mean": a.mean(0), "std": a.std(0)} for a in (obs, act)]
+    torch.manual_seed(cfg.seed)
+    module = MLPPolicy(MLPConfig(hidden=list(cfg.hidden)), *stats)
+    last = module.net[-1]
+    assert isinstance(last, torch.nn.Linear)
+    with torch.no_grad():
+        last.weight.mul_(0.01)
+        last.bias.zero_()
+    env = flight.make_env()
+    names = list(env.task.observation_names)
+    env.close()
+    from gymfg_il.sim.properties import ACTION_NAMES
+
+    meta = {
+        "observation_names": names,
+        "action_names": list(ACTION_NAMES),
+        "fps": flight.agent_hz,
+        "dataset": None,
+        "camera": None,
+        "obs_stats": {k: v.tolist() for k, v in stats[0].items()},
+        "action_stats": {k: v.tolist() for k, v in stats[1].items()},
+    }
+    return Start(module, meta, flight)
+
+
+def stats_of(module: Any, name: str) -> dict[str, np.ndarray]:
+    norm = getattr(module, name)
+    return {"mean": norm.mean.double().numpy(), "std": norm.std.double().numpy()}
+
+
+def as_ppo(actor: Any) -> Any:
+    """A copy of the actor in eval mode whose config is a ``ppo`` policy's (its network)."""
+    from gymfg_il.policies.configuration_ppo import PPOConfig
+
+    module = copy.deepcopy(actor).eval()
+    module.config = PPOConfig(hidden=list(actor.config.hidden))
+    return module
+
+
+def meta_of(start: Start) -> dict[str, Any]:
+    """What the result keeps of the starting policy's config.json: what it observes and acts
+    on, its rate, and its data and BC run (DAgger trains the result again on them)."""
+    keep = ("observation_names", "action_names", "fps", "dataset", "train", "camera")
+    return {k: start.meta[k] for k in keep if k in start.meta}

@@ -1,0 +1,181 @@
+"""PPO fine-tuning (``train ppo``): the actor starts as the cloned policy, a short run saves a
+policy that eval flies, a seeded run repeats, and what cannot be fine-tuned is refused."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from gymfg_il.errors import ConfigError
+from gymfg_il.learning.bc import train_bc
+from gymfg_il.learning.config import TrainConfig
+from gymfg_il.policies.factory import make_config
+from gymfg_il.rl.config import PPORunConfig
+
+pytest.importorskip("stable_baselines3")
+
+
+@pytest.fixture(scope="module")
+def bc_policy(tiny_dataset, tmp_path_factory):
+    """An MLP cloned from the tiny altitude demonstrations (30-s episodes)."""
+    out = tmp_path_factory.mktemp("rl") / "bc"
+    train_bc(TrainConfig(dataset=tiny_dataset, out=out, epochs=3, seed=0))
+    return out
+
+
+def _short(bc_policy, out, **changes):
+    settings = dict(
+        init=bc_policy, out=out, steps=1024, envs=2, rollout_steps=256, batch_size=128,
+        epochs=2, eval_every=1024, eval_episodes=2, critic_warmup=256, seed=3,
+    )  # fmt: skip
+    return PPORunConfig(**{**settings, **changes})
+
+
+def test_the_actor_starts_as_the_cloned_policy(bc_policy, tmp_path):
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from gymfg_il.policies.agent import PolicyAgent
+    from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.run import make_model
+    from gymfg_il.rl.start import starting_policy, stats_of
+
+    cfg = _short(bc_policy, tmp_path / "ppo")
+    start = starting_policy(cfg)
+    action = stats_of(start.module, "action_norm")
+    spec = start.flight.to_dict()
+    venv = DummyVecEnv([lambda: make_env(spec, action["mean"], action["std"])])
+    try:
+        model = make_model(cfg, venv, start.module, tmp_path / "tb", "cpu")
+        env = start.flight.make_env()
+        bc = PolicyAgent.load(bc_policy)
+        for seed in (5, 6, 7):
+            obs, _ = env.reset(seed=seed)
+            batch = torch.as_tensor(obs[None], dtype=torch.float32)
+            mean = model.policy.get_distribution(batch).distribution.mean
+            assert torch.equal(mean, bc.policy(batch))  # bit for bit, normalised
+            normalised, _ = model.policy.predict(obs, deterministic=True)
+            raw = venv.envs[0].env.action(normalised)  # Monitor(NormalizedActions(env))
+            np.testing.assert_allclose(raw, np.clip(bc.act(obs), *_bounds(env)), atol=1e-5)
+        env.close()
+    finally:
+        venv.close()
+
+
+def _bounds(env):
+    return env.action_space.low, env.action_space.high
+
+
+def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
+    from safetensors.torch import load_file
+
+    from gymfg_il.evaluation.config import EvalConfig
+    from gymfg_il.evaluation.runner import run_eval
+    from gymfg_il.rl.run import train_ppo
+
+    out = tmp_path / "ppo"
+    result = train_ppo(_short(bc_policy, out, turbulence="light"))
+    assert result.steps >= 1024
+    assert [p.step for p in result.curve] == [0, 1024]
+    config = json.loads((out / "config.json").read_text())
+    assert config["type"] == "ppo" and config["policy"]["hidden"] == [256, 256]
+    assert config["spec"]["turbulence"] == "light"
+    assert config["rl"]["init"] == str(bc_policy) and config["train"]  # DAgger retrains on it
+    assert (out / "curve.png").stat().st_size > 1000
+    assert list((out / "tensorboard").rglob("events.out.tfevents.*"))
+    # the best evaluation's actor is kept (the start's, where nothing beat it)
+    best = max(result.curve, key=lambda p: (p.success, p.mean_return))
+    assert config["rl"]["kept"] == {"which": "best", "step": best.step}
+    kept = load_file(str(out / "model.safetensors"))
+    start = load_file(str(bc_policy / "model.safetensors"))
+    assert set(kept) == set(start)
+    same = all(torch.equal(kept[k], start[k]) for k in start)
+    assert same == (best.step == 0)
+    # eval flies it beside the policy it started from, in the weather the flags give
+    run = run_eval(EvalConfig(policy=[out, bc_policy], episodes=2, seed=9000, turbulence="none"))
+    assert [r["agent"] for r in run.rows] == ["controller", "policy:ppo", "policy:bc"]
+    assert run.flight.turbulence == "none"
+    assert any("different weather" in n and "as asked" in n for n in run.notes)
+
+
+def test_a_seeded_run_repeats(bc_policy, tmp_path):
+    from safetensors.torch import load_file
+
+    from gymfg_il.rl.run import train_ppo
+
+    runs = []
+    for name, seed in (("a", 3), ("b", 3), ("c", 4)):
+        cfg = _short(bc_policy, tmp_path / name, steps=512, eval_every=10_000, seed=seed)
+        cfg.keep = "last"
+        train_ppo(cfg)
+        runs.append(load_file(str(tmp_path / name / "model.safetensors")))
+    start = load_file(str(bc_policy / "model.safetensors"))
+    assert all(torch.equal(runs[0][k], runs[1][k]) for k in runs[0])
+    assert not all(torch.equal(runs[0][k], runs[2][k]) for k in runs[0])  # the seed matters
+    assert not all(torch.equal(runs[0][k], start[k]) for k in start)  # the actor learnt
+
+
+def test_what_cannot_be_fine_tuned_is_refused(bc_policy, tiny_dataset, tmp_path):
+    from gymfg_il.rl.start import starting_policy
+
+    with pytest.raises(ConfigError, match="--init POLICY"):
+        PPORunConfig()
+    with pytest.raises(ConfigError, match="keeps the policy's own task"):
+        starting_policy(PPORunConfig(init=bc_policy, task="heading"))
+    gru = tmp_path / "gru"
+    train_bc(
+        TrainConfig(dataset=tiny_dataset, out=gru, epochs=1, policy=make_config("gru", hidden=8))
+    )
+    with pytest.raises(ConfigError, match="gru policy; PPO fine-tunes MLP policies only"):
+        starting_policy(PPORunConfig(init=gru))
+
+
+def test_a_ppo_policy_retrains_as_an_mlp(bc_policy):
+    from gymfg_il.learning.dagger import retrain_config
+    from gymfg_il.policies.configuration_mlp import MLPConfig
+
+    meta = json.loads((bc_policy / "config.json").read_text())
+    meta["policy"]["type"] = meta["type"] = "ppo"
+    cfg = retrain_config(meta, bc_policy, bc_policy.parent / "again")
+    assert type(cfg.policy) is MLPConfig and cfg.policy.hidden == [256, 256]
+
+
+def test_train_bc_does_not_offer_ppo():
+    from gymfg_il.train import build_parser
+
+    p = build_parser()
+    with pytest.raises(SystemExit):
+        p.parse_args(["bc", "--policy", "ppo"])
+    assert p.parse_args(["ppo", "--init", "x"]).algorithm == "ppo"
+
+
+def test_the_success_bonus_follows_the_verdict_eval_gives(bc_policy):
+    from gymfg_il.evaluation.runner import evaluate
+    from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.start import starting_policy
+    from gymfg_il.rollout.agents import AgentSpec
+
+    flight = starting_policy(PPORunConfig(init=bc_policy)).flight  # 30-s altitude episodes
+    env = make_env(flight.to_dict(), [0.0] * 4, [1.0] * 4, success_bonus=0.5)  # raw actions
+    seeds = [10, 11, 12]
+    outcomes = set()
+    for spec in (AgentSpec.controller(), AgentSpec.policy(bc_policy)):
+        pilot = spec.make(env.unwrapped)
+        rows, _ = evaluate(flight, {"agent": spec}, seeds)
+        for seed, episode in zip(seeds, rows[0]["per_episode"], strict=True):
+            obs, _ = env.reset(seed=seed)
+            pilot.reset(seed)
+            if hasattr(pilot, "start_from"):  # the controller starts from the trim, as flown
+                pilot.start_from(env.unwrapped.world.slots[0].action)
+            rewards, done = [], False
+            while not done:
+                obs, reward, terminated, truncated, info = env.step(pilot.act(obs))
+                rewards.append(reward)
+                done = terminated or truncated
+            assert info["is_success"] == episode["success"], (spec, seed)
+            bonus = 0.5 * len(rewards) if episode["success"] else 0.0
+            assert sum(rewards) == pytest.approx(episode["total_return"] + bonus, abs=1e-6)
+            outcomes.add(episode["success"])
+    assert outcomes == {True, False}  # both ways were checked
