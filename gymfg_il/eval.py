@@ -59,8 +59,10 @@ def _main(cfg: object, show_progress: bool) -> int:
     for note in run.notes:
         print(note, file=sys.stderr)
     flight, seeds = run.flight, cfg.seeds
+    air = "" if flight.turbulence == "none" else f", {flight.turbulence} turbulence"
+    air += f", {flight.wind_kt:g} kt wind" if flight.wind_kt else ""
     print(
-        f"{flight.task_label} on {flight.aircraft} at {flight.agent_hz} Hz: {len(seeds)} "
+        f"{flight.task_label} on {flight.aircraft} at {flight.agent_hz} Hz{air}: {len(seeds)} "
         f"episodes of {flight.episode_time_s:g} s, seeds {seeds[0]}..{seeds[-1]}\n"
     )
     print(table(run.rows))

@@ -31,13 +31,15 @@ def flight_for(
     options = options or FlightOptions()
     specs = {path: meta.get("spec") for path, meta in policies.items()}
     known = {p: FlightSpec.from_dict(s) for p, s in specs.items() if s}
-    distinct = {s.to_json(): p for p, s in known.items()}
+    calm = {p: s.replace(**STILL_AIR) for p, s in known.items()}
+    distinct = {s.to_json(): p for p, s in calm.items()}
     if len(distinct) > 1:
         a, b = list(distinct.values())[:2]
         raise ConfigError(
             f"{a} and {b} were trained on different flights; every agent of one evaluation "
             "flies the same cases: evaluate them separately"
         )
+    weather_notes = _weather_notes(known, options)
     agent_hz = options.agent_hz
     if not known:
         missing = ", ".join(str(p) for p in policies)
@@ -77,7 +79,32 @@ def flight_for(
         )
     if "task" in changes and "task_kwargs" not in asked:
         changes["task_kwargs"] = {}  # another task's options would not fit
-    return base.replace(**changes), notes
+    return base.replace(**changes), weather_notes + notes
+
+
+STILL_AIR = {"turbulence": "none", "wind_kt": 0.0, "wind_from_deg": None}
+
+
+def _weather_notes(known: Mapping[Path, FlightSpec], options: FlightOptions) -> list[str]:
+    """Policies whose flights differ only in the weather (a policy fine-tuned in turbulence
+    beside the one it started from) fly together in the weather the options give, else the
+    first policy's: a note says which, and what each was trained in."""
+    weathers = {p: {k: getattr(s, k) for k in STILL_AIR} for p, s in known.items()}
+    if len({repr(w) for w in weathers.values()}) < 2:
+        return []
+    first = next(iter(weathers))
+    flown = {**weathers[first], **{k: v for k, v in options.given().items() if k in STILL_AIR}}
+    whose = "as asked" if any(k in options.given() for k in STILL_AIR) else f"{first}'s"
+    said = ", ".join(f"{k}={flown[k]!r}" for k in STILL_AIR if k != "wind_from_deg")
+    trained = "; ".join(
+        f"{p}: {'no' if w['turbulence'] == 'none' else w['turbulence']} turbulence, "
+        f"{w['wind_kt']:g} kt wind"
+        for p, w in weathers.items()
+    )
+    return [
+        f"note: these policies were trained in different weather ({trained}); all fly in "
+        f"{said} ({whose})"
+    ]
 
 
 def policy_meta(path: Path) -> dict[str, Any]:
