@@ -1,7 +1,7 @@
 """``python -m benchmarks.run``: every benchmark, side by side in one run, printed as rows
 (name, value, unit, target) under the references measured beside them.
 
-    python -m benchmarks.run [--quick] [--only physics,data,workers,manual,online] [--json PATH]
+    python -m benchmarks.run [--quick] [--only physics,data,workers,manual,online,rl] [--json PATH]
 
 Rows: env_step_vs_raw_jsbsim and per_aircraft_8_vs_1 (``physics``),
 dataset_build_frames_per_s and train_pipeline_frames_per_s (``data``),
@@ -9,7 +9,8 @@ rollout_workers_vs_ceiling and ray_vs_pool_2_workers (``workers``),
 camera_frames_per_s (``camera``),
 manual_loop_p99_period_error_ms, synthetic_pilot_x_realtime and
 input_to_record_p99_steps (``manual``),
-online_{2,8,16}_teams_steps_per_s and online_2_teams_pinned_steps_per_s (``online``). Ratios
+online_{2,8,16}_teams_steps_per_s and online_2_teams_pinned_steps_per_s (``online``),
+rl_sampling_vs_physics_bound with cores and 4 x cores envs (``rl``). Ratios
 are medians of paired rounds (see ``benchmarks.common``).
 """
 
@@ -22,7 +23,7 @@ from pathlib import Path
 
 from benchmarks.common import Row, print_rows
 
-CONCERNS = ("physics", "workers", "data", "camera", "manual", "online")
+CONCERNS = ("physics", "workers", "data", "camera", "manual", "online", "rl")
 
 
 def main(argv: list[str] | None = None) -> int:
