@@ -20,10 +20,12 @@ class DivergedError(ConfigError):
     """Training whose loss or weights stopped being finite numbers; nothing is saved."""
 
 
-def check_diverged(policy: Any, settings: str, epoch: int | None = None) -> None:
+def check_diverged(
+    policy: Any, settings: str, epoch: int | None = None, fix: str = "lower --lr (default 1e-3)"
+) -> None:
     """Refuse (``DivergedError``) a run at ``epoch``, whose loss was not finite, or (no
     ``epoch``) a policy whose weights are not all finite; ``settings`` names the run's step
-    sizes for the message."""
+    sizes for the message, ``fix`` what to change."""
     import torch
 
     if epoch is None and all(bool(torch.isfinite(t).all()) for t in policy.state_dict().values()):
@@ -31,7 +33,7 @@ def check_diverged(policy: Any, settings: str, epoch: int | None = None) -> None
     when = f"in epoch {epoch + 1} (the loss is not finite)" if epoch is not None else ""
     raise DivergedError(
         f"training diverged {when or '(its weights are not finite)'} with {settings}; "
-        "nothing was saved: lower --lr (default 1e-3)"
+        f"nothing was saved: {fix}"
     )
 
 

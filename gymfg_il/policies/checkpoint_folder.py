@@ -23,7 +23,11 @@ from pathlib import Path
 
 from gymfg_il.errors import ConfigError
 
-POLICY_FILES = frozenset({"config.json", "model.safetensors", "loss.png", "train_log.json"})
+# what a policy folder holds (``train bc``'s, and ``train ppo``'s curve and TensorBoard log)
+POLICY_FILES = frozenset(
+    {"config.json", "model.safetensors", "loss.png", "train_log.json"}
+    | {"curve.json", "curve.png", "tensorboard"}
+)
 PARTIAL, OLD = "partial", "old"
 AT_FDCWD, RENAME_EXCHANGE = -100, 2  # <fcntl.h>, <linux/fs.h>
 

@@ -31,7 +31,8 @@ class PPORunConfig:
         envs: environments sampled in parallel, one process each (0: four per CPU core, which
             samples about twice as fast as one per core: ``benchmarks.rl``).
         seed: seeds the envs (env k starts from seed + k), the sampling and the networks; a
-            run with the same settings repeats exactly.
+            run with the same settings and the same number of envs repeats exactly (give
+            --envs to repeat a run on a machine with other cores).
         eval_every: evaluate the policy's mean action every this many env steps.
         eval_episodes: held-out episodes each evaluation flies (seeds eval_seed, eval_seed +
             1, ...), the same every time, with the controller on them once.
@@ -59,8 +60,9 @@ class PPORunConfig:
         action_std: the exploration noise's starting spread in the policy's normalised action
             units (1 = the demonstrations' spread of each control).
         critic_warmup: env steps over which only the critic learns, the actor held, so the
-            first actor updates follow a trained value function (default: a tenth of the
-            run, at least one rollout, at most 20,000 steps).
+            first actor updates follow a trained value function: every update on a rollout
+            that began before this many steps (default: a tenth of the run, at most 20,000
+            steps; at least one rollout).
         success_bonus: at the end of each training episode, the task judges it as eval does,
             and a success adds this share of the episode's steps to its return (a step's task
             reward is at most about 1), so what PPO maximises includes what success measures
@@ -117,10 +119,12 @@ class PPORunConfig:
                 "give --init POLICY (a cloned MLP to fine-tune) or, from scratch, --task and "
                 "--aircraft"
             )
-        positive = ("steps", "eval_every", "eval_episodes", "rollout_steps", "batch_size")
-        for name in (*positive, "epochs"):
+        positive = ("steps", "eval_every", "eval_episodes", "rollout_steps", "epochs")
+        for name in positive:
             if getattr(self, name) < 1:
                 problems.append(f"{name}={getattr(self, name)} must be >= 1")
+        if self.batch_size < 2:  # PPO normalises each batch's advantages
+            problems.append(f"batch_size={self.batch_size} must be >= 2")
         if self.sde_every < 0:
             problems.append(f"sde_every={self.sde_every}: want 0 (once a rollout) or more")
         if self.envs < 0:
@@ -170,7 +174,7 @@ class PPORunConfig:
     def warmup_steps(self) -> int:
         if self.critic_warmup is not None:
             return self.critic_warmup
-        return min(20_000, max(self.rollout, self.steps // 10))
+        return max(self.rollout, min(20_000, self.steps // 10))
 
     @property
     def anchor_span(self) -> int:

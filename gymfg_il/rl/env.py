@@ -77,10 +77,12 @@ class SuccessBonus(gym.Wrapper):
         if self._at is not None:
             self._errors.append(float(obs[self._at]))
         if terminated or truncated:
-            success = not terminated and bool(self._judge())
-            info["is_success"] = success
+            # a maneuver the library cannot judge (a task of your own) earns no bonus
+            success = False if terminated else self._judge()
+            if success is not None:
+                info["is_success"] = success
             if success:
-                reward = float(reward) + self.share * len(self._errors or self._states[1:])
+                reward = float(reward) + self.share * (len(self._states) - 1)
         return obs, float(reward), terminated, truncated, info
 
     def _judge(self) -> bool | None:
@@ -96,7 +98,8 @@ def make_env(
 ) -> gym.Env:
     """One training env (picklable, built in its own process): the flight ``spec`` taking
     actions in the policy's normalised units, its episodes' task returns logged
-    (stable-baselines3's ``Monitor``) and, with ``success_bonus``, judged."""
+    (stable-baselines3's ``Monitor``, ``rollout/ep_rew_mean``: without the bonus) and,
+    with ``success_bonus``, judged."""
     from stable_baselines3.common.monitor import Monitor
 
     env = FlightSpec.from_dict(spec).make_env()

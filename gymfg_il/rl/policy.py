@@ -2,7 +2,7 @@
 
 The actor *is* the MLP policy (``policies.modeling_mlp``): the same network and the same
 normalisation, its output the mean of PPO's Gaussian, in the MLP's normalised action units.
-The env takes actions in those units (``learning.rl_env.NormalizedActions``), so before any
+The env takes actions in those units (``rl.env.NormalizedActions``), so before any
 update PPO's mean action is, bit for bit, the action the cloned policy flies.
 
 Two things keep the first updates from undoing the cloning:
@@ -133,17 +133,17 @@ class AnchoredPolicy(ActorCriticPolicy):
         else:
             self.log_std = nn.Parameter(torch.full((start.n_act,), float(self.log_std_init)))
         self.value_net = Critic(start.obs_norm, self._critic_hidden)  # type: ignore[assignment]
-        anchor = copy.deepcopy(start).eval()
-        for p in anchor.parameters():
-            p.requires_grad_(False)
-        self._anchor = [anchor]  # kept out of the parameters (and the optimiser)
+        # the start, frozen: a submodule, so it moves to the policy's device, and kept out
+        # of the optimiser's groups
+        self.anchor_net = copy.deepcopy(start).eval()
+        self.anchor_net.requires_grad_(False)
         for buffer in (*self.action_net.buffers(), *self.value_net.buffers()):
             buffer.requires_grad_(False)
         actor = [*self.action_net.parameters(), self.log_std]
-        mine = {id(p) for p in actor}
+        left_out = {id(p) for p in (*actor, *self.anchor_net.parameters())}
         groups = [
             {"params": actor, "scale": self._actor_lr_scale},
-            {"params": [p for p in self.parameters() if id(p) not in mine], "scale": 1.0},
+            {"params": [p for p in self.parameters() if id(p) not in left_out], "scale": 1.0},
         ]
         self.optimizer = AnchoredAdam(
             groups, policy=self, lr=lr_schedule(1), **self.optimizer_kwargs
@@ -184,7 +184,7 @@ class AnchoredPolicy(ActorCriticPolicy):
         if obs is None or self.anchor_weight <= 0 or not self.log_std.requires_grad:
             return None
         with torch.no_grad():
-            target = self._anchor[0](obs)
+            target = self.anchor_net(obs)
         loss: torch.Tensor = self.anchor_weight * nn.functional.mse_loss(
             self.action_net(obs), target
         )

@@ -74,13 +74,14 @@ def _train(
     on_eval: Callable[[EvalPoint], None] | None,
     start: Start,
 ) -> PPOResult:
-    from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
 
     from gymfg_il.learning.config import resolve_device
+    from gymfg_il.policies.checkpoint_folder import check_out
 
     flight, module = start.flight, start.module
     out = Path(cfg.out or f"policies/ppo-{flight.task}-{flight.aircraft}")
+    check_out(out)  # before training, not after
     seeds = list(range(cfg.eval_seed, cfg.eval_seed + cfg.eval_episodes))
     began = time.perf_counter()
     scratch_dir = Path(tempfile.mkdtemp(prefix="gymfg-ppo-"))
@@ -99,10 +100,13 @@ def _train(
             cfg.success_bonus,
         )
         n = cfg.n_envs
-        venv = make_vec_env(
-            env_fn, n_envs=n, seed=cfg.seed, vec_env_cls=SubprocVecEnv if n > 1 else DummyVecEnv
+        venv: Any = (SubprocVecEnv if n > 1 else DummyVecEnv)([env_fn] * n)
+        venv.seed(cfg.seed)  # env k's first reset takes seed + k
+        # rewards scaled by the running spread of the discounted return, never clipped (the
+        # success bonus comes as one large reward)
+        venv = VecNormalize(
+            venv, norm_obs=False, norm_reward=True, gamma=cfg.gamma, clip_reward=math.inf
         )
-        venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=cfg.gamma)
         try:
             model = make_model(
                 cfg, venv, module, scratch_dir / "tensorboard", resolve_device(cfg.device)
@@ -112,18 +116,17 @@ def _train(
             model.logger.close()
         finally:
             venv.close()
-        result_step = model.num_timesteps
-        if curve[-1].step != model.num_timesteps:
-            curve.append(judge(model.policy.actor, model.num_timesteps))
-            if on_eval:
-                on_eval(curve[-1])
+        last = model.policy.actor  # after the last update, which no evaluation has seen
+        curve.append(judge(last, model.num_timesteps))
+        if on_eval:
+            on_eval(curve[-1])
         seconds = time.perf_counter() - began
         assert judge.best is not None
-        kept = (judge.best[1], judge.best[2]) if cfg.keep == "best" else (result_step, None)
-        result = PPOResult(
-            out, model.num_timesteps, seconds, curve, controller, start.notes, kept[0]
+        step, actor = (
+            (judge.best[1], judge.best[2]) if cfg.keep == "best" else (curve[-1].step, last)
         )
-        _save(cfg, result, start, kept[1] or model.policy.actor, scratch_dir / "tensorboard")
+        result = PPOResult(out, model.num_timesteps, seconds, curve, controller, start.notes, step)
+        _save(cfg, result, start, actor, scratch_dir / "tensorboard")
         return result
     finally:
         shutil.rmtree(scratch_dir, ignore_errors=True)
@@ -142,7 +145,8 @@ class FineTunePPO(PPO):
     def train(self) -> None:
         policy = self.policy
         assert isinstance(policy, AnchoredPolicy)
-        frozen = self.num_timesteps <= self.warmup
+        # the rollout this update learns from began at num_timesteps - n_steps x n_envs
+        frozen = self.num_timesteps - self.n_steps * self.n_envs < self.warmup
         policy.freeze_actor(frozen)
         done = max(0, self.num_timesteps - self.warmup)
         weight = self.anchor * max(0.0, 1.0 - done / self.span) if self.span else 0.0
@@ -218,7 +222,9 @@ class _Watch(BaseCallback):
             self.on_steps(self.training_env.num_envs)
         return True
 
-    def _on_rollout_end(self) -> None:
+    def _on_rollout_start(self) -> None:
+        # after the update on the rollout that ended here (the last update is evaluated by
+        # train_ppo, after learn)
         if self.num_timesteps < self.next_eval:
             return
         while self.next_eval <= self.num_timesteps:
@@ -242,7 +248,7 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, tb: Pa
     from gymfg_il.policies.checkpoint_folder import staged
 
     module = as_ppo(actor)
-    check_diverged(module, f"lr={cfg.lr}")
+    check_diverged(module, f"lr={cfg.lr}", fix="lower --lr (default 3e-4)")
     flight = start.flight
     name = Path(result.out).name
     settings = {k: str(v) if isinstance(v, Path) else v for k, v in asdict(cfg).items()}

@@ -44,7 +44,13 @@ def starting_policy(cfg: PPORunConfig) -> Start:
             f"--init {cfg.init}: not a policy of ours (no config.json); give a folder "
             "`train bc --policy mlp` wrote"
         )
-    kind = meta["policy"].get("type", meta["type"])
+    settings = meta["policy"]
+    if not isinstance(settings, dict):
+        raise ConfigError(
+            f"--init {cfg.init}: its config.json's policy entry is {type(settings).__name__}, "
+            "not the settings a policy records; train the MLP again"
+        )
+    kind = settings.get("type", meta["type"])
     if kind not in INIT_TYPES:
         raise ConfigError(
             f"--init {cfg.init} is a {kind} policy; PPO fine-tunes MLP policies only, for now "
@@ -125,14 +131,15 @@ def scratch_policy(cfg: PPORunConfig) -> Start:
 
 def stats_of(module: Any, name: str) -> dict[str, np.ndarray]:
     norm = getattr(module, name)
-    return {"mean": norm.mean.double().numpy(), "std": norm.std.double().numpy()}
+    return {"mean": norm.mean.double().cpu().numpy(), "std": norm.std.double().cpu().numpy()}
 
 
 def as_ppo(actor: Any) -> Any:
-    """A copy of the actor in eval mode whose config is a ``ppo`` policy's (its network)."""
+    """A copy of the actor on the CPU, in eval mode, whose config is a ``ppo`` policy's (its
+    network)."""
     from gymfg_il.policies.configuration_ppo import PPOConfig
 
-    module = copy.deepcopy(actor).eval()
+    module = copy.deepcopy(actor).cpu().eval()
     module.config = PPOConfig(hidden=list(actor.config.hidden))
     return module
 

@@ -103,18 +103,64 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
 def test_a_seeded_run_repeats(bc_policy, tmp_path):
     from safetensors.torch import load_file
 
+    from gymfg_il.evaluation.runner import evaluate
     from gymfg_il.rl.run import train_ppo
+    from gymfg_il.rollout.agents import AgentSpec
 
-    runs = []
+    runs, results = [], []
     for name, seed in (("a", 3), ("b", 3), ("c", 4)):
-        cfg = _short(bc_policy, tmp_path / name, steps=512, eval_every=10_000, seed=seed)
+        cfg = _short(bc_policy, tmp_path / name, eval_every=10_000, seed=seed)
         cfg.keep = "last"
-        train_ppo(cfg)
+        results.append(train_ppo(cfg))
         runs.append(load_file(str(tmp_path / name / "model.safetensors")))
+    # the last point of the curve is the saved actor's (after the last update)
+    last = results[0].curve[-1]
+    assert last.step == results[0].steps == results[0].kept_step
+    seeds = list(range(cfg.eval_seed, cfg.eval_seed + cfg.eval_episodes))
+    rows, _ = evaluate(_flight(bc_policy), {"a": AgentSpec.policy(tmp_path / "a")}, seeds)
+    assert (rows[0]["success_rate"], rows[0]["mean_return"]) == (last.success, last.mean_return)
     start = load_file(str(bc_policy / "model.safetensors"))
     assert all(torch.equal(runs[0][k], runs[1][k]) for k in runs[0])
     assert not all(torch.equal(runs[0][k], runs[2][k]) for k in runs[0])  # the seed matters
     assert not all(torch.equal(runs[0][k], start[k]) for k in start)  # the actor learnt
+
+
+def _flight(bc_policy):
+    from gymfg_il.rl.start import starting_policy
+
+    return starting_policy(PPORunConfig(init=bc_policy)).flight
+
+
+def test_the_critic_warms_up_before_the_actor_moves(bc_policy, tmp_path):
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.run import make_model
+    from gymfg_il.rl.start import starting_policy, stats_of
+
+    cfg = PPORunConfig(
+        init=bc_policy, envs=1, rollout_steps=64, batch_size=32, epochs=2, critic_warmup=128,
+        exploration="gaussian", seed=1,
+    )  # fmt: skip
+    start = starting_policy(cfg)
+    action = stats_of(start.module, "action_norm")
+    spec = start.flight.to_dict()
+    venv = DummyVecEnv([lambda: make_env(spec, action["mean"], action["std"], 0.2)])
+    model = make_model(cfg, venv, start.module, tmp_path / "tb", "cpu")
+
+    def weights(module):
+        return [p.detach().clone() for p in module.parameters()]
+
+    def same(before, module):
+        return all(torch.equal(a, b) for a, b in zip(before, weights(module), strict=True))
+
+    actor, critic = weights(model.policy.action_net), weights(model.policy.value_net)
+    model.learn(128)  # two rollouts, both begun inside the warm-up
+    assert same(actor, model.policy.action_net)
+    assert not same(critic, model.policy.value_net)
+    model.learn(192, reset_num_timesteps=False)  # past it: the actor moves
+    assert not same(actor, model.policy.action_net)
+    venv.close()
 
 
 def test_what_cannot_be_fine_tuned_is_refused(bc_policy, tiny_dataset, tmp_path):
