@@ -19,20 +19,20 @@ EVAL_SEED=${EVAL_SEED:-9300}
 
 for task in $TASKS; do
   dir="$OUT/$task"
-  if [ "$task" = turn ]; then  # the novice pilot, in still air
-    air=none
+  if [ "$task" = turn ]; then  # the novice pilot, in still air, at a person's 30 Hz
+    air=none rate=30
     python -m gymfg_il.collect manual --pilot synthetic --device keyboard --task turn \
       --skill 0.2 --pilot-name novice --episodes 30 --seed 1000 --out "$dir" --no-progress
   else
-    air=moderate
+    air=moderate rate=10
     python -m gymfg_il.collect autopilot --task "$task" --episodes 10 --seed 500 --out "$dir" \
       --no-progress
   fi
   python -m gymfg_il.train bc --dataset "$dir/dataset" --out "$dir/bc" --no-progress
   python -m gymfg_il.train ppo --init "$dir/bc" --turbulence "$air" --steps "$STEPS" \
     --out "$dir/ppo" --no-progress
-  python -m gymfg_il.train ppo --task "$task" --aircraft c172p --turbulence "$air" \
-    --steps "$STEPS" --out "$dir/scratch" --no-progress
+  python -m gymfg_il.train ppo --task "$task" --aircraft c172p --agent-hz "$rate" \
+    --turbulence "$air" --steps "$STEPS" --out "$dir/scratch" --no-progress
   python -m gymfg_il.eval --policy "$dir/ppo" "$dir/bc" "$dir/scratch" --turbulence "$air" \
     --episodes "$EVALS" --seed "$EVAL_SEED" --json "$dir/eval.json" --no-progress
 done

@@ -25,6 +25,8 @@ class PPORunConfig:
         out: where the policy goes (default: policies/ppo-<task>-<aircraft>).
         task: the task, from scratch; with --init it must be the policy's own.
         aircraft: the aircraft, from scratch; with --init it must be the policy's own.
+        agent_hz: the agent rate (Hz), from scratch (default: 10; with --init: the policy's
+            own, and another is refused).
         turbulence: the air to train in: none, light, moderate or severe (default: the
             starting policy's; a change is printed as a note).
         wind_kt: a steady wind (knots) to train in (default: the starting policy's).
@@ -81,6 +83,7 @@ class PPORunConfig:
     out: Path | None = None
     task: str | None = None
     aircraft: str | None = None
+    agent_hz: int | None = None
     turbulence: Turbulence | None = None
     wind_kt: float | None = None
     envs: int = 0

@@ -64,12 +64,12 @@ def starting_policy(cfg: PPORunConfig) -> Start:
     own = FlightSpec.from_dict(meta["spec"])
     if not own.is_solo:
         raise ConfigError(f"--init {cfg.init} flies a team flight; PPO here trains solo flights")
-    for name, given in (("task", cfg.task), ("aircraft", cfg.aircraft)):
+    for name, given in (("task", cfg.task), ("aircraft", cfg.aircraft), ("agent_hz", cfg.agent_hz)):
         if given is not None and given != getattr(own, name):
             raise ConfigError(
-                f"--{name} {given}: {cfg.init} flies {name} {getattr(own, name)}; fine-tuning "
-                f"keeps the policy's own {name} (drop --{name}, or start from a policy of "
-                f"{given})"
+                f"--{name.replace('_', '-')} {given}: {cfg.init} flies {name} "
+                f"{getattr(own, name)}; fine-tuning keeps the policy's own {name} (drop the "
+                f"flag, or start from a policy of {given})"
             )
     module, meta = load_policy(cfg.init)
     if getattr(module.config, "dropout", 0.0):
@@ -98,7 +98,11 @@ def scratch_policy(cfg: PPORunConfig) -> Start:
     from gymfg_il.rollout.seeded import fly_many
 
     options = FlightOptions(
-        aircraft=cfg.aircraft, task=cfg.task, turbulence=cfg.turbulence, wind_kt=cfg.wind_kt
+        aircraft=cfg.aircraft,
+        task=cfg.task,
+        agent_hz=cfg.agent_hz,
+        turbulence=cfg.turbulence,
+        wind_kt=cfg.wind_kt,
     )
     flight = options.flight()
     flown = [e.solo for e in fly_many(flight, AgentSpec.controller(), SCRATCH_SEEDS)]
