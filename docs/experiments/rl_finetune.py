@@ -65,6 +65,7 @@ def plot(out: Path, png: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter
 
     tasks = [t for t in TASKS if _curve(out / t / "ppo")]
     fig, axes = plt.subplots(1, len(tasks), figsize=(4 * len(tasks), 3.4), squeeze=False)
@@ -81,6 +82,7 @@ def plot(out: Path, png: Path) -> None:
         ax.axhline(100 * c["controller"]["success"], color="green", ls=":", label="controller")
         ax.set_title(task)
         ax.set_xlabel("env steps")
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x / 1000:.0f}k"))
         ax.set_ylim(-5, 105)
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel("success % (16 seeds)")
