@@ -170,7 +170,7 @@ def test_what_cannot_be_fine_tuned_is_refused(bc_policy, tiny_dataset, tmp_path)
         PPORunConfig()
     with pytest.raises(ConfigError, match="keeps the policy's own task"):
         starting_policy(PPORunConfig(init=bc_policy, task="heading"))
-    with pytest.raises(ConfigError, match="--agent-hz 30: .* flies agent_hz 10"):
+    with pytest.raises(ConfigError, match=r"--agent-hz 30: .* flies agent_hz 10"):
         starting_policy(PPORunConfig(init=bc_policy, agent_hz=30))
     gru = tmp_path / "gru"
     train_bc(
