@@ -23,7 +23,11 @@ import copy
 from typing import Any
 
 import torch
-from stable_baselines3.common.distributions import Distribution, StateDependentNoiseDistribution
+from stable_baselines3.common.distributions import (
+    DiagGaussianDistribution,
+    Distribution,
+    StateDependentNoiseDistribution,
+)
 from stable_baselines3.common.policies import ActorCriticPolicy
 from torch import nn
 
@@ -168,7 +172,8 @@ class AnchoredPolicy(ActorCriticPolicy):
         if isinstance(self.action_dist, StateDependentNoiseDistribution):
             features = self.actor.obs_norm(latent_pi)
             return self.action_dist.proba_distribution(mean, self.log_std, features)
-        return super()._get_action_dist_from_latent(latent_pi)
+        assert isinstance(self.action_dist, DiagGaussianDistribution)
+        return self.action_dist.proba_distribution(mean, self.log_std)  # one pass of the actor
 
     def evaluate_actions(
         self, obs: torch.Tensor | dict[str, torch.Tensor], actions: torch.Tensor
