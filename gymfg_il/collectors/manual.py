@@ -127,6 +127,7 @@ class ManualSession:
         self.timing = EpisodeTiming(self.env.dt)  # collectors.timing, for real-time sessions
         self._period: float | None = None  # the loop period that produced this frame
         self._late_at = -math.inf  # when a frame last came late
+        self._read_at = -1.0  # the wall clock when this frame's input was read
         self.images, self.image_size = list(config.images), config.image_size
         names = self.env.observation_names
         check_appendable(out, names, flight.agent_hz, None, self.images, self.image_size)
@@ -284,7 +285,7 @@ class ManualSession:
 
     def _step(self) -> None:
         tick = self.rollout.step()
-        self._writer().log_tick(tick)
+        self._writer().log_tick(tick, self._read_at if self.realtime else None)
         (step,) = tick.steps
         self.last_action = step.action
         self._flown.append(step.state.copy())
@@ -329,6 +330,7 @@ class ManualSession:
                 if self.on_frame is not None:
                     self.on_frame(frame, self)
                 events = pygame.event.get()
+                self._read_at = time.time()  # the input this frame flies by is read now
                 commands = self.human.handle(events, period)
                 for ev in events:
                     if ev.type == pygame.QUIT:

@@ -6,8 +6,9 @@ person saw is kept beside it: a frame is late when the loop period that produced
 ``LATE_FACTOR`` times the nominal one; an episode counts its late frames (and is kept), the
 window warns while they happen, and the episode's end event, its dataset columns
 (``gymfg/late_frames``, ``gymfg/rate_hz``, ``gymfg/jitter_ms``) and the card give the rate
-achieved and its jitter. Sessions that run as fast as they can (the synthetic pilot) record
-none of it, and stay bit-reproducible.
+achieved and its jitter; each frame keeps the wall clock its input was read at (the log's
+``wall_time_s``, the dataset's ``wall_time``: ``datasets.features``). Sessions that run as
+fast as they can (the synthetic pilot) record none of it, and stay bit-reproducible.
 """
 
 from __future__ import annotations

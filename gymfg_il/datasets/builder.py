@@ -18,7 +18,12 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
-from gymfg_il.datasets.features import ENVIRONMENT_STATE, check_compatible
+from gymfg_il.datasets.features import (
+    ENVIRONMENT_STATE,
+    NO_WALL_TIME,
+    WALL_TIME,
+    check_compatible,
+)
 from gymfg_il.datasets.videos import VideoTrack
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import task_columns
@@ -135,14 +140,18 @@ class DatasetBuilder:
         n = len(columns["action"])
         if n == 0:
             raise ConfigError("an episode needs at least one frame")
-        if self._environment is not None and ENVIRONMENT_STATE not in columns:
+        given = dict(columns)
+        if self._environment is not None and ENVIRONMENT_STATE not in given:
             state = np.asarray(columns["observation.state"])
-            given = {
-                **columns,
-                ENVIRONMENT_STATE: np.ascontiguousarray(state[:, self._environment]),
-            }
-            # in the features' order, as LeRobot's writer keeps its statistics
-            columns = {k: given[k] for k in meta.features if k in given}
+            given[ENVIRONMENT_STATE] = np.ascontiguousarray(state[:, self._environment])
+        if WALL_TIME in meta.features and WALL_TIME not in given:
+            given[WALL_TIME] = np.full(n, NO_WALL_TIME)  # flown faster than real time
+        unknown = sorted(set(given) - set(meta.features) - {WALL_TIME})
+        if unknown:
+            raise ConfigError(f"the dataset has no features {unknown}; its: {list(meta.features)}")
+        # in the features' order, as LeRobot's writer keeps its statistics; a wall time the
+        # dataset has no column for (one begun faster than real time) is left out
+        columns = {k: given[k] for k in meta.features if k in given}
         index = meta.total_episodes
         start = meta.total_frames
         frames = {

@@ -9,6 +9,10 @@
 | next.reward | float32 | (1,) | reward of the step |
 | next.done | bool | (1,) | the episode ended with this step |
 | intervention | bool | (1,) | a human flew this step (human takeover / DAgger) |
+| wall_time | float32 | (1,) | wall-clock s from the episode's first frame to this frame's input |
+| | | | (beside ``timestamp``, the simulation's): only in a dataset made from logs with frames |
+| | | | flown in real time (``collectors.timing``); -1 in frames flown faster. The episode's |
+| | | | ``gymfg/wall_start`` is its first frame's wall clock (Unix s) |
 | observation.images.<view> | video | (H, W, 3) | camera frames, only with ``images`` |
 
 ``observation.environment_state`` repeats what ``observation.state`` already holds: LeRobot's
@@ -31,13 +35,20 @@ from gymfg_il.sim.properties import ACTION_NAMES, task_columns
 
 OUR_KEYS = ("observation.state", "action", "next.reward", "next.done", "intervention")
 ENVIRONMENT_STATE = "observation.environment_state"
+WALL_TIME = "wall_time"
+NO_WALL_TIME = -1.0  # a frame flown faster than real time, in a dataset with the column
 
 
 def dataset_features(
-    observation_names: Sequence[str], images: Sequence[str] = (), image_size: int = 128
+    observation_names: Sequence[str],
+    images: Sequence[str] = (),
+    image_size: int = 128,
+    wall_clock: bool = False,
 ) -> dict[str, dict[str, Any]]:
     """Our features for a task observing ``observation_names``, with the camera ``images``
-    (views) as square video features of ``image_size`` pixels."""
+    (views) as square video features of ``image_size`` pixels, and with ``wall_clock`` the
+    ``wall_time`` of each frame (a dataset made from frames flown in real time)."""
+    clock = {WALL_TIME: {"dtype": "float32", "shape": (1,), "names": None}}
     videos = {
         f"observation.images.{view}": {
             "dtype": "video",
@@ -66,6 +77,7 @@ def dataset_features(
         "next.reward": {"dtype": "float32", "shape": (1,), "names": None},
         "next.done": {"dtype": "bool", "shape": (1,), "names": None},
         "intervention": {"dtype": "bool", "shape": (1,), "names": None},
+        **(clock if wall_clock else {}),
     }
 
 

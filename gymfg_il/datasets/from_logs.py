@@ -28,7 +28,7 @@ import numpy as np
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs
-from gymfg_il.datasets.features import check_compatible, dataset_features
+from gymfg_il.datasets.features import WALL_TIME, check_compatible, dataset_features
 from gymfg_il.datasets.gather import (
     LogOutcome,
     Unreadable,
@@ -78,7 +78,16 @@ def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarr
         "next.reward": steps.reward,
         "next.done": done,
         "intervention": steps.intervention,
+        WALL_TIME: _since_first(steps.wall_time),
     }
+
+
+def _since_first(clock: np.ndarray) -> np.ndarray:
+    """Wall-clock seconds since the episode's first frame (where the log kept a time, else
+    -1): LeRobot loads floats as float32, which would round Unix seconds to minutes."""
+    if clock[0] < 0:
+        return np.full_like(clock, -1.0)
+    return np.where(clock >= 0, clock - clock[0], -1.0)
 
 
 def target_record(task: dict[str, Any], target: float | None) -> dict[str, Any]:
@@ -124,6 +133,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "verdict": _text(end.get("verdict")),
         "grade": str(end["grade"]) if rank(end.get("grade")) >= 0 else "",
         **_timing(end),
+        "wall_start": float(episode.steps[callsign].wall_time[0]),  # Unix s, or -1
         "mark": episode.mark,
         "log": log.path.name,
         "log_episode": int(episode.index),
@@ -261,7 +271,6 @@ def _build(
     views = check_views(first_log.session.get("images", []) if images is None else images)
     size = int(first_log.session.get("image_size", DEFAULT_IMAGE_SIZE))
     cameras = {image_key(v): Camera(size, size, view=v) for v in views}
-    features = dataset_features(info["observation_names"], views, size)
     fps = first_log.spec.agent_hz
     label = info["task"].get("task", "task")
     repo_id = repo_id or f"gymfg/{label}-{info['model']}"
@@ -279,6 +288,10 @@ def _build(
                         (lg, episode, callsign, EpisodeRef(lg.path.name, episode.index, callsign))
                     )
     logged = {ref: episode_columns(ep, c) for _, ep, c, ref in offered}
+    # frames flown in real time keep their wall time in a dataset made now (not in one
+    # made without the column: its features stay)
+    clock = any((columns[WALL_TIME] >= 0).any() for columns in logged.values())
+    features = dataset_features(info["observation_names"], views, size, clock)
     work = root.with_name(f"{root.name}.building-{time.time_ns()}")
     found: list[str] = []
     refs: list[EpisodeRef | None] = []

@@ -31,6 +31,7 @@ from gymfg_il.recording.mcap_walk import (
     string_map,
     summary_intact,
 )
+from gymfg_il.recording.schemas import EPISODE_TOPIC
 from gymfg_il.recording.session import (
     CHANNELS_METADATA,
     CRC_KEY,
@@ -38,7 +39,6 @@ from gymfg_il.recording.session import (
     SESSION_METADATA,
     crc_state,
 )
-from gymfg_il.recording.writer import EPISODE_TOPIC
 
 _U16 = struct.Struct("<H")
 _RECORD = struct.Struct("<BQ")

@@ -4,6 +4,7 @@ or not (a bad chunk costs the episodes it held, and ``Log.damage`` says which an
 from __future__ import annotations
 
 import gc
+import math
 import os
 import stat
 from dataclasses import dataclass, field
@@ -46,6 +47,8 @@ class AircraftSteps:
     terminated: np.ndarray
     truncated: np.ndarray
     intervention: np.ndarray
+    # real time only: the wall clock (Unix s) when each step's input was read; -1 elsewhere
+    wall_time: np.ndarray
     numbers: list[int] = field(default_factory=list, repr=False)  # the logged step numbers
     raw_states: list[Any] = field(default_factory=list, repr=False)
     _state: np.ndarray | None = field(default=None, repr=False)
@@ -149,9 +152,18 @@ def _steps(rows: list[dict[str, Any]], states: list[Any]) -> AircraftSteps:
         terminated=np.array([r.get("terminated", False) for r in rows], dtype=bool),
         truncated=np.array([r.get("truncated", False) for r in rows], dtype=bool),
         intervention=np.array([r.get("intervention", False) for r in rows], dtype=bool),
+        wall_time=np.array([_clock(r.get("wall_time_s")) for r in rows], dtype=np.float64),
         numbers=[int(r["step"]) for r in rows],
         raw_states=states,
     )
+
+
+def _clock(value: Any) -> float:
+    """A logged wall-clock time, or -1 where none was logged or it is not a time (a log is
+    hostile: a string, a bool, NaN or a negative number reads as none)."""
+    if type(value) not in (int, float) or not math.isfinite(value) or value < 0:
+        return -1.0
+    return float(value)
 
 
 def read_bytes(path: Path) -> bytes:

@@ -30,6 +30,33 @@ from gymfg_il.recording import foxglove
 from gymfg_il.sim.properties import ACTION_NAMES, CATALOGUE
 from gymfg_il.tasks.grades import GRADES
 
+EPISODE_TOPIC = "/gymfg/episode"
+
+
+def step_topic(callsign: str) -> str:
+    return f"/gymfg/{callsign}/step"
+
+
+def state_topic(callsign: str) -> str:
+    return f"/gymfg/{callsign}/state"
+
+
+def location_topic(callsign: str) -> str:
+    return f"/gymfg/{callsign}/location"
+
+
+def transform_topic(callsign: str) -> str:
+    return f"/gymfg/{callsign}/tf"
+
+
+def scene_topic(callsign: str) -> str:
+    return f"/gymfg/{callsign}/scene"
+
+
+def view_topic(team: str) -> str:
+    return f"/gymfg/team/{team}/opponents"
+
+
 _ACTION = {
     "type": "object",
     "properties": {n: {"type": "number"} for n in ACTION_NAMES},
@@ -54,6 +81,10 @@ STEP = {
         "terminated": {"type": "boolean"},
         "truncated": {"type": "boolean"},
         "intervention": {"type": "boolean", "description": "a human flew this step"},
+        "wall_time_s": {
+            "type": "number",
+            "description": "real time only: the wall clock (Unix s) when the input was read",
+        },
     },
     "required": ["episode", "step", "observation", "action", "label", "reward"],
 }

@@ -23,13 +23,21 @@ from mcap.writer import CompressionType, IndexType, Writer
 
 from gymfg_il.recording import foxglove as fg
 from gymfg_il.recording import schemas
+from gymfg_il.recording.schemas import (
+    EPISODE_TOPIC,
+    location_topic,
+    scene_topic,
+    state_topic,
+    step_topic,
+    transform_topic,
+    view_topic,
+)
 from gymfg_il.recording.session import CHANNELS_METADATA, SESSION_COPY, SESSION_METADATA, checked
 from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
 from gymfg_il.sim.properties import ACTION_NAMES, INDEX, NAMES
 from gymfg_il.tasks.scenery import task_landmarks
 from gymfg_il.units import DEG_TO_RAD, FT_TO_M
 
-EPISODE_TOPIC = "/gymfg/episode"
 _INITIAL = ("lat_deg", "lon_deg", "altitude_ft")
 _HEADING = INDEX["heading_deg"]
 _NO_COVARIANCE = [0.0] * 9
@@ -46,30 +54,6 @@ def _start_record(s: Start) -> dict[str, Any]:
     if s.task.get("plan") is not None:
         record["plan"] = s.task["plan"]
     return record
-
-
-def step_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/step"
-
-
-def state_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/state"
-
-
-def location_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/location"
-
-
-def transform_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/tf"
-
-
-def scene_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/scene"
-
-
-def view_topic(team: str) -> str:
-    return f"/gymfg/team/{team}/opponents"
 
 
 class TrajectoryWriter:
@@ -253,13 +237,14 @@ class TrajectoryWriter:
         self._emit(self._tfs[callsign], message)
         return where, velocity
 
-    def log_tick(self, tick: Tick) -> None:
-        """Log one agent step of the flight: every aircraft's step and each team's view."""
+    def log_tick(self, tick: Tick, wall_time_s: float | None = None) -> None:
+        """Log one agent step of the flight: every aircraft's step and each team's view
+        (``wall_time_s``: in a session flown in real time, when its input was read)."""
         self._at_step(tick.step)
         for s in tick.steps:
             self.log_step(
                 s.callsign, s.step, s.state, s.observation, s.action, s.label, s.reward,
-                s.terminated, s.truncated, s.intervention,
+                s.terminated, s.truncated, s.intervention, wall_time_s,
             )  # fmt: skip
         for team, view in tick.views.items():
             self.log_view(team, tick.step, view)
@@ -302,9 +287,12 @@ class TrajectoryWriter:
         terminated: bool = False,
         truncated: bool = False,
         intervention: bool = False,
+        wall_time_s: float | None = None,
     ) -> None:
-        """Log one agent step of ``callsign`` (state after the step, action that led to it)."""
+        """Log one agent step of ``callsign`` (state after the step, action that led to it;
+        ``wall_time_s`` only in real time: the wall clock when the input was read)."""
         values = state.tolist()
+        clock = {} if wall_time_s is None else {"wall_time_s": float(wall_time_s)}
         self._emit(
             self._steps[callsign],
             {
@@ -318,6 +306,7 @@ class TrajectoryWriter:
                 "terminated": bool(terminated),
                 "truncated": bool(truncated),
                 "intervention": bool(intervention),
+                **clock,
             },
         )
         self._emit(

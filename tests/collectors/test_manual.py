@@ -12,6 +12,7 @@ import pygame
 
 from gymfg_il.collectors.config import ManualConfig
 from gymfg_il.collectors.manual import ManualSession
+from gymfg_il.datasets.lerobot_api import open_metadata
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.data import load_frames
@@ -407,6 +408,26 @@ def test_a_slow_loop_counts_its_late_frames_and_the_window_warns(tmp_path):
     assert 5 < eps["gymfg/rate_hz"][0] < 27.5 and eps["gymfg/jitter_ms"][0] > 10
     card = (tmp_path / "dataset" / "README.md").read_text()
     assert f"| timing | {late} late frame(s) in 1 of 1 real-time episodes; episode 0: " in card
+    # each frame keeps the wall clock its input was read at, from the episode's first
+    # frame (its Unix time in gymfg/wall_start): the slow frames show there, beside the
+    # simulation's timestamp, which stays frame / fps
+    clock, timestamp = frame_columns(tmp_path / "dataset", "wall_time", "timestamp")
+    gaps = np.diff(clock)
+    assert len(clock) == 90 and clock[0] == 0 and (gaps > 0).all()
+    assert abs(eps["gymfg/wall_start"][0] - time.time()) < 60
+    assert sum(gaps > 0.09) >= 6 and sum(gaps > 1.5 / 30) == pytest.approx(late, abs=1)
+    assert np.median(gaps) == pytest.approx(1 / 30, abs=0.01)  # paced at 30 Hz otherwise
+    assert clock[-1] - timestamp[-1] > 0.4  # the flight ran 0.6 s slower than its simulation
+    np.testing.assert_allclose(timestamp, np.arange(90) / 30, atol=1e-6)
+
+
+def frame_columns(root, *names):
+    """Per-frame columns of a dataset, as stock LeRobot loads them."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    dataset = LeRobotDataset("gymfg/test", root=root)
+    frames = [dataset[i] for i in range(dataset.num_frames)]
+    return [np.array([float(f[n]) for f in frames]) for n in names]
 
 
 def test_a_session_run_as_fast_as_it_can_records_no_timing(tmp_path):
@@ -415,3 +436,4 @@ def test_a_session_run_as_fast_as_it_can_records_no_timing(tmp_path):
     assert eps["gymfg/late_frames"] == [-1] and eps["gymfg/rate_hz"] == [-1.0]
     card = (tmp_path / "dataset" / "README.md").read_text()
     assert "| timing | not recorded (no episode was flown in real time) |" in card
+    assert "wall_time" not in open_metadata(tmp_path / "dataset").features  # no clock to keep

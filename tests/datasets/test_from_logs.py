@@ -137,3 +137,48 @@ def test_verdict_pilot_and_mark_columns_take_only_what_they_hold(built):
     assert columns["jitter_ms"] == -1.0
     long = dataclasses.replace(episode, start={**episode.start, "pilot": "x" * 5000})
     assert len(episode_metadata(log, long, callsign)["pilot"]) == 200
+
+
+def test_a_wall_clock_column_where_frames_were_flown_in_real_time(built, tmp_path):
+    """A frame flown in real time keeps the wall clock its input was read at (seconds from
+    the episode's first frame; the first frame's Unix time per episode); a dataset with the
+    column reads -1 for frames flown faster; one without it takes real-time frames without
+    their clock; the log's clock is hostile until checked."""
+    import dataclasses
+
+    import pyarrow.parquet as pq
+
+    from gymfg_il.datasets.builder import DatasetBuilder
+    from gymfg_il.datasets.features import dataset_features
+    from gymfg_il.datasets.from_logs import episode_columns, episode_metadata
+    from gymfg_il.recording.reader import _clock
+
+    out, result, _ = built
+    assert "wall_time" not in pq.read_schema(next((out / "dataset/data").rglob("*.parquet")))
+    log = read_log(result.log)
+    fast = log.complete_episodes[0]
+    steps = fast.steps["ego"]
+    assert (steps.wall_time == -1).all()
+    assert episode_metadata(log, fast, "ego")["wall_start"] == -1
+    clock = 1.8e9 + 0.04 * np.arange(len(steps))
+    timed = dataclasses.replace(fast, steps={"ego": dataclasses.replace(steps, wall_time=clock)})
+    columns = episode_columns(timed, "ego")
+    np.testing.assert_allclose(columns["wall_time"], 0.04 * np.arange(len(steps)), atol=1e-6)
+    assert episode_metadata(log, timed, "ego")["wall_start"] == 1.8e9
+    names = log.aircraft("ego")["observation_names"]
+    read = {}
+    for name, clocked in (("clocked", True), ("plain", False)):
+        features = dataset_features(names, (), 128, clocked)
+        builder = DatasetBuilder(tmp_path / name, "gymfg/t", 10, features)
+        builder.add_episode(columns, "hold")
+        builder.add_episode(episode_columns(fast, "ego"), "hold")
+        with pytest.raises(ConfigError, match=r"no features \['bogus'\]"):
+            builder.add_episode({**columns, "bogus": columns["action"]}, "hold")
+        builder.finalize()
+        read[name] = pq.read_table(next((tmp_path / name / "data").rglob("*.parquet")))
+    wall = read["clocked"]["wall_time"].to_numpy()
+    np.testing.assert_allclose(wall[:150], 0.04 * np.arange(150), atol=1e-5)
+    assert (wall[150:] == -1).all() and "wall_time" not in read["plain"].column_names
+    assert [_clock(v) for v in (1.5, 3, "2", True, float("nan"), -4.0, None)] == [
+        1.5, 3.0, -1, -1, -1, -1, -1,
+    ]  # fmt: skip
