@@ -46,16 +46,32 @@ class Hands:
         anticipate: how far it leads a moving reading, as a share of its delay
             (``manual.synthetic``): a person leads an agile aircraft, whose attitude moves
             within its reaction time, and not a slow one, whose readings it would only shake.
+        slot_ahead_ft: how far ahead of a formation slot it keeps station. On an aircraft
+            with little power to spare a wingman sits a little ahead: dropping back takes a
+            touch of power, catching up full power for many seconds (on the outside of the
+            lead's turn, none is left).
+        slot_track: share of the expert's gain towards a formation slot's side line (with
+            the expert's, the c172p's pilot chased it in +-30 deg banks, turning away from a
+            lead that rolled the other way).
+        slot_throttle_floor: the least throttle it sets in formation: a wingman works the
+            power in small changes; at idle a c172p loses 10 kt in a few seconds and needs
+            many more to win them back (BC from its pilot learnt such cuts and fell behind).
     """
 
     pitch_damping: float = 0.5
     slip_gain: float = 0.4
     station: float = 0.5
     anticipate: float = 0.0
+    slot_ahead_ft: float = 0.0
+    slot_track: float = 1.0
+    slot_throttle_floor: float = 0.0
 
 
 # tuned on seeds 100-163 (docs/results/cockpit.md); an aircraft not named flies with Hands()
-HANDS: dict[str, Hands] = {"f15": Hands(anticipate=0.5)}
+HANDS: dict[str, Hands] = {
+    "f15": Hands(anticipate=0.5),
+    "c172p": Hands(slot_ahead_ft=30.0, slot_track=0.5, slot_throttle_floor=0.4),
+}
 # where each task's loops take their targets from on the display (the expert's other settings
 # and gains stay); a target task's bug is named as the expert's source already
 DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
@@ -117,6 +133,9 @@ class DisplayIntent:
         kp, kd = targets.station_gains
         station = (kp * self.hands.station, kd * self.hands.station)
         targets = dataclasses.replace(targets, station_gains=station)
+        if targets.station_source is not None:  # a slot's side line, not a runway's
+            track = targets.track_gain * self.hands.slot_track
+            targets = dataclasses.replace(targets, track_gain=track)
         self.readings = reading_names(task)
         self.names = (*self.readings, *MOTION)
         self.angular = np.array([n in ANGLES for n in self.names])
@@ -124,6 +143,8 @@ class DisplayIntent:
         gains = hands_of(expert.gains, self.hands)
         self.autopilot = Autopilot(self.names, model, dt, targets, gains=gains)
         self.autopilot.set_throttle_trim(throttle)
+        if targets.station_source is not None:
+            self.autopilot.speed_pid.out_min = self.hands.slot_throttle_floor
         self._last: dict[str, float] | None = None
 
     @property
@@ -150,4 +171,7 @@ class DisplayIntent:
         return np.array(values, dtype=np.float64)
 
     def act(self, seen: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        if self.hands.slot_ahead_ft and "behind_slot_ft" in self.names:
+            seen = seen.copy()
+            seen[self.names.index("behind_slot_ft")] += self.hands.slot_ahead_ft
         return self.autopilot.act(seen)
