@@ -12,6 +12,8 @@ from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.sim.weather import Turbulence
 from gymfg_il.typecheck import type_problems
 
+ANCHOR_SPAN_MAX = 150_000  # the longest the anchor decays over by default (``anchor_steps``)
+
 
 @dataclass
 class PPORunConfig:
@@ -72,7 +74,8 @@ class PPORunConfig:
         anchor: weight, at the start, of the squared distance between the actor's mean action
             and the starting policy's (normalised units) added to PPO's loss; it decays
             linearly to 0 over anchor_steps (0: no anchor). Not used from scratch.
-        anchor_steps: env steps over which the anchor decays (default: half the run).
+        anchor_steps: env steps over which the anchor decays (default: half the run, at most
+            150k: a longer anchor holds a long run at its start; docs/results/rl.md).
         critic: hidden widths of the critic (value network).
         hidden: hidden widths of the actor, from scratch (with --init: the policy's own).
         device: cpu or cuda (the networks are small: cpu is usually faster).
@@ -181,4 +184,6 @@ class PPORunConfig:
 
     @property
     def anchor_span(self) -> int:
-        return self.steps // 2 if self.anchor_steps is None else self.anchor_steps
+        if self.anchor_steps is not None:
+            return self.anchor_steps
+        return min(self.steps // 2, ANCHOR_SPAN_MAX)

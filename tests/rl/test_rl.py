@@ -163,6 +163,14 @@ def test_the_critic_warms_up_before_the_actor_moves(bc_policy, tmp_path):
     venv.close()
 
 
+def test_the_anchor_lets_go_within_150k_steps_unless_told(bc_policy):
+    # half of a short run; a long run is not held at its start for half its length
+    spans = [PPORunConfig(init=bc_policy, steps=n).anchor_span for n in (100_000, 300_000)]
+    assert spans == [50_000, 150_000]
+    assert PPORunConfig(init=bc_policy, steps=1_000_000).anchor_span == 150_000
+    assert PPORunConfig(init=bc_policy, steps=10**6, anchor_steps=500_000).anchor_span == 500_000
+
+
 def test_what_cannot_be_fine_tuned_is_refused(bc_policy, tiny_dataset, tmp_path):
     from gymfg_il.rl.start import starting_policy
 
