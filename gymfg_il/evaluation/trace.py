@@ -95,7 +95,8 @@ def make_trace(
     if plan is not None:
         from gymfg_il.tasks.library import task_class
 
-        judged = task_class(task["task"]).judge(plan, states, dt)  # type: ignore[attr-defined]
+        judge = task_class(task["task"]).judge  # type: ignore[attr-defined]
+        judged = judge(plan, states, dt, gusty)
         verdict, detail = judged.success, judged.detail
     value = after[:, names.index(tracked["variable"])]
     error = after[:, names.index(tracked["error"])]

@@ -17,7 +17,7 @@ from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.grades import Measure
-from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft
+from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft, size
 from gymfg_il.tasks.rewards import closeness
 from gymfg_il.tasks.scenery import Landmark
 from gymfg_il.units import FT_PER_NM, KT_TO_FPS, wrap_180, wrap_360
@@ -137,7 +137,9 @@ class WaypointsTask(ManeuverTask):
         return found
 
     @classmethod
-    def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
+    def judge(
+        cls, plan: dict[str, Any], states: np.ndarray, dt: float, gusty: bool = False
+    ) -> Verdict:
         north, east = local_ft(states, plan["origin"])
         alt = states[:, _ALT]
         at, off, high = 0, [], []
@@ -305,7 +307,9 @@ class ApproachTask(ManeuverTask):
         return [Landmark("runway", lat, lon, alt, course, width_ft=150.0, length_ft=5000.0)]
 
     @classmethod
-    def judge(cls, plan: dict[str, Any], states: np.ndarray, dt: float) -> Verdict:
+    def judge(
+        cls, plan: dict[str, Any], states: np.ndarray, dt: float, gusty: bool = False
+    ) -> Verdict:
         g = cls.geometry(plan, states)
         tan = math.tan(math.radians(plan["glide_deg"]))
         at_dh = plan["decision_height_ft"] / tan
@@ -315,15 +319,16 @@ class ApproachTask(ManeuverTask):
             return Verdict(False, f"ended {left:.2f} NM short of the decision height")
         flown = slice(0, int(reached[0]) + 1)
         final = g["distance"][flown] <= plan["hold_from_ft"]
+        how = " on average" if gusty else ""
         for key, what in (("glidepath", "glide path"), ("offset", "centre line")):
-            worst = float(np.abs(g[key][flown][final]).max())
+            worst = size(g[key][flown][final], gusty)
             if worst > cls.tolerances[what]:
-                return Verdict(False, f"{worst:.0f} ft off the {what} on final")
-        worst = float(np.abs(g["airspeed"][flown][final]).max())
+                return Verdict(False, f"{worst:.0f} ft off the {what}{how} on final")
+        worst = size(g["airspeed"][flown][final], gusty)
         if worst > cls.tolerances["airspeed"]:
-            return Verdict(False, f"{worst:.1f} kt off the approach speed on final")
+            return Verdict(False, f"{worst:.1f} kt off the approach speed{how} on final")
         measures = tuple(
-            Measure.of(what, unit, g[key][flown][final], cls.tolerances[what])
+            Measure.of(what, unit, g[key][flown][final], cls.tolerances[what], mean=gusty)
             for key, what, unit in (
                 ("glidepath", "glide path", "ft"),
                 ("offset", "centre line", "ft"),

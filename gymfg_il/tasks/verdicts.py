@@ -4,7 +4,8 @@ scores episodes with it, the manual window's debrief states it).
 The error must stay within the tolerance through the last ``HOLD_S`` seconds; a moving
 target's tolerance is ``TRACKING_FACTOR`` times the static one; in turbulence a gust carries
 any aircraft past a calm-air tolerance for a moment, so there the error must average within
-the tolerance over those seconds instead. Maneuvers judge themselves (``ManeuverTask.judge``).
+the tolerance over those seconds instead. Maneuvers judge themselves (``ManeuverTask.judge``),
+by the same token in turbulence (``tasks.maneuvers``).
 ``judge_flight`` judges any flown episode from its task's record, with the measures its grade
 reads (``tasks.grades``): the manual window's debrief and the autopilot's collector use it.
 """
@@ -75,7 +76,7 @@ def judge_flight(
                 judge = None
             if judge is None:
                 return None, "", ()
-        verdict = judge(plan, states, dt)
+        verdict = judge(plan, states, dt, gusty)
         return verdict.success, verdict.detail, verdict.measures
     tracked = task.get("tracked")
     if not tracked:

@@ -313,3 +313,31 @@ def test_formation_observes_the_slot_from_the_leads_pose_alone():
     again.lead_pilot = LeadPilot("c172p", DT)
     again.reset(track(1, heading_deg=90.0, altitude_ft=5000.0)[0], np.random.default_rng(4))
     assert again.plan["lead"] == task.plan["lead"]
+
+
+def test_in_turbulence_a_moment_past_a_tolerance_counts_as_an_average():
+    # a gust carries any aircraft past a calm-air tolerance for a moment (tasks.verdicts):
+    # gusty, an error a rule bounds at every moment must average within its tolerance
+    from gymfg_il.sim.properties import INDEX
+
+    plan = {"turn_deg": 120.0, "start_heading_deg": 350.0, "altitude_ft": 5000.0}
+    bumped = turn_states(120.0, alt_bump=101.0)
+    assert not TurnTask.judge(plan, bumped, DT).success
+    gusty = TurnTask.judge(plan, bumped, DT, gusty=True)
+    assert gusty.success and [m.kind for m in gusty.measures] == ["mean", "mean"]
+    # a gust of 25 kt on final for a second
+    gust = final()
+    gust[700:710, INDEX["airspeed_kts"]] += 25.0
+    assert not ApproachTask.judge(APPROACH, gust, DT).success
+    assert ApproachTask.judge(APPROACH, gust, DT, gusty=True).success
+    slow = ApproachTask.judge(APPROACH, final(speed=81.0), DT, gusty=True)
+    assert not slow.success and "approach speed on average" in slow.detail
+    # the slot: 105 ft off for the last 30 s of 60 judged averages within 100; 250 does not
+    task, plan, states = formation(late_error=105.0)
+    assert task.judge(plan, states, DT, gusty=True).success
+    task, plan, states = formation(late_error=250.0)
+    far = task.judge(plan, states, DT, gusty=True)
+    assert not far.success and "on average" in far.detail
+    # the lead is kept clear of in any air
+    task, plan, states = formation(behind=30.0, right=20.0)
+    assert "within" in task.judge(plan, states, DT, gusty=True).detail
