@@ -33,24 +33,9 @@ from gymfg_il.tasks.grades import GRADES
 EPISODE_TOPIC = "/gymfg/episode"
 
 
-def step_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/step"
-
-
-def state_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/state"
-
-
-def location_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/location"
-
-
-def transform_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/tf"
-
-
-def scene_topic(callsign: str) -> str:
-    return f"/gymfg/{callsign}/scene"
+def aircraft_topic(callsign: str, channel: str) -> str:
+    """One aircraft's channel: ``step``, ``state``, ``location``, ``tf`` or ``scene``."""
+    return f"/gymfg/{callsign}/{channel}"
 
 
 def view_topic(team: str) -> str:

@@ -23,15 +23,7 @@ from mcap.writer import CompressionType, IndexType, Writer
 
 from gymfg_il.recording import foxglove as fg
 from gymfg_il.recording import schemas
-from gymfg_il.recording.schemas import (
-    EPISODE_TOPIC,
-    location_topic,
-    scene_topic,
-    state_topic,
-    step_topic,
-    transform_topic,
-    view_topic,
-)
+from gymfg_il.recording.schemas import EPISODE_TOPIC, aircraft_topic, view_topic
 from gymfg_il.recording.session import CHANNELS_METADATA, SESSION_COPY, SESSION_METADATA, checked
 from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
 from gymfg_il.sim.properties import ACTION_NAMES, INDEX, NAMES
@@ -118,11 +110,11 @@ class TrajectoryWriter:
             return channel_id
 
         self._events = channel(EPISODE_TOPIC, event)
-        self._steps = {c: channel(step_topic(c), step) for c in callsigns}
-        self._states = {c: channel(state_topic(c), state) for c in callsigns}
-        self._fixes = {c: channel(location_topic(c), fix) for c in callsigns}
-        self._tfs = {c: channel(transform_topic(c), tf) for c in callsigns}
-        self._scenes = {c: channel(scene_topic(c), scene) for c in callsigns}
+        self._steps = {c: channel(aircraft_topic(c, "step"), step) for c in callsigns}
+        self._states = {c: channel(aircraft_topic(c, "state"), state) for c in callsigns}
+        self._fixes = {c: channel(aircraft_topic(c, "location"), fix) for c in callsigns}
+        self._tfs = {c: channel(aircraft_topic(c, "tf"), tf) for c in callsigns}
+        self._scenes = {c: channel(aircraft_topic(c, "scene"), scene) for c in callsigns}
         self._look = {
             c: (a.get("model", ""), teams.index(a["team"])) for c, a in session["aircraft"].items()
         }
