@@ -24,6 +24,7 @@ from gymfg_il.units import FT_PER_NM, KT_TO_FPS, wrap_180, wrap_360
 
 _ALT, _HDG, _VC = INDEX["altitude_ft"], INDEX["heading_deg"], INDEX["airspeed_kts"]
 _LAT, _LON = INDEX["lat_deg"], INDEX["lon_deg"]
+_ROLL = INDEX["roll_deg"]
 
 
 class WaypointsTask(ManeuverTask):
@@ -190,7 +191,8 @@ class ApproachTask(ManeuverTask):
     Success: the aircraft reaches the decision height (200 ft above the threshold on the
     path), and from 2.5 NM out down to it stays within 100 ft of the glide path, 200 ft of
     the centre line and 10 kt of the approach speed. Grade: the glide-path, centre-line
-    (localizer) and airspeed errors from 2.5 NM out to the decision height.
+    (localizer) and airspeed errors from 2.5 NM out to the decision height, and the bank
+    there (of 15 deg, the most a stabilized final allows).
     Start and end: as every maneuver (module docstring); 180 s episodes on every aircraft
     (the final grows with the approach speed instead).
     """
@@ -212,6 +214,9 @@ class ApproachTask(ManeuverTask):
     decision_height_ft = 200.0
     hold_from_nm = 2.5
     tolerances = {"glide path": 100.0, "centre line": 200.0, "airspeed": 10.0}  # noqa: RUF012
+    # the bank a stabilized final allows (the FAA's Airplane Flying Handbook: no more than
+    # 15 deg on final); graded, never a success rule
+    final_bank_deg = 15.0
 
     @classmethod
     def flown_kts(cls, profile: FlightProfile) -> float:
@@ -335,4 +340,6 @@ class ApproachTask(ManeuverTask):
                 ("airspeed", "airspeed", "kt"),
             )
         )
+        bank = states[flown][final, _ROLL]
+        measures += (Measure.of("bank", "deg", bank, cls.final_bank_deg, mean=gusty),)
         return Verdict(True, f"decision height at {reached[0] * dt:.1f} s, on the path", measures)

@@ -83,3 +83,24 @@ def test_the_briefing_says_how_each_task_is_graded():
     assert "Grade" not in success[1:]  # the success sentence stops where the grade begins
     env = FlightSpec.solo("c172p", "altitude").make_env()
     assert "Grade: the error over the last 10 s" in " ".join(briefing(env.world.slots[0].task, 90))
+
+
+def test_the_approach_grades_the_bank_on_final_but_does_not_fail_it():
+    from gymfg_il.tasks.courses import ApproachTask
+
+    flight = FlightSpec.solo("c172p", "approach")
+    (ep,) = fly_many(flight, AgentSpec.controller(), [4402])
+    env = flight.make_env()
+    env.reset(seed=4402)
+    plan = env.world.slots[0].task.plan
+    states = np.vstack([ep.solo.start.state[None], ep.solo.states])
+    flown = ApproachTask.judge(plan, states, ep.dt)
+    bank = flown.measures[-1]
+    assert (bank.name, bank.tolerance) == ("bank", 15.0) and bank.value < 3.75
+    # a wing down 10 deg all the way down the final: two thirds of the bank a stabilized
+    # final allows, fair; the needles are untouched, so still a success
+    final = ApproachTask.geometry(plan, states)["distance"] <= plan["hold_from_ft"]
+    states[final, INDEX["roll_deg"]] = 10.0
+    banked = ApproachTask.judge(plan, states, ep.dt)
+    assert banked.success and banked.measures[:3] == flown.measures[:3]
+    assert banked.measures[-1].value == 10.0 and banked.grade == "fair"
