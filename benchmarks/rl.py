@@ -1,6 +1,7 @@
 """RL sampling (``train ppo``): stable-baselines3's PPO collecting rollouts (policy inference
-included) from N subprocess envs, against the physics it cannot beat: min(N, cores) bare
-JSBSim loops doing the same agent steps (c172p altitude, 10 Hz = 12 JSBSim frames).
+included) from N envs in one process per core (``rl.vec``, as ``train ppo`` runs them),
+against the physics it cannot beat: min(N, cores) bare JSBSim loops doing the same agent
+steps (c172p altitude, 10 Hz = 12 JSBSim frames).
 
     python -m benchmarks.rl [--envs 2 8 16]
 """
@@ -19,13 +20,12 @@ from benchmarks.physics import raw_loop
 
 def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     """(collect about ``steps`` env steps with PPO's own rollout loop, close) for PPO around
-    a fresh MLP on ``n_envs`` subprocess envs (one per process, as ``train ppo`` runs)."""
+    a fresh MLP on ``n_envs`` envs, grouped in one process per core as ``train ppo`` runs them."""
     import tempfile
     from functools import partial
 
     import numpy as np
-    from stable_baselines3.common.env_util import make_vec_env
-    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
     from gymfg_il.envs.flight import FlightSpec
     from gymfg_il.policies.configuration_mlp import MLPConfig
@@ -33,6 +33,7 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     from gymfg_il.rl.config import PPORunConfig
     from gymfg_il.rl.env import make_env
     from gymfg_il.rl.run import make_model
+    from gymfg_il.rl.vec import GroupedVecEnv
 
     flight = FlightSpec.solo("c172p", "altitude")
     env = flight.make_env()
@@ -40,10 +41,10 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     env.close()
     stats = [{"mean": np.zeros(n), "std": np.ones(n)} for n in (n_obs, 4)]
     module = MLPPolicy(MLPConfig(), *stats)
-    cls = SubprocVecEnv if n_envs > 1 else DummyVecEnv
-
     env_fn = partial(make_env, flight.to_dict(), [0.0] * 4, [1.0] * 4, 0.2)
-    venv = make_vec_env(env_fn, n_envs, seed=0, vec_env_cls=cls)
+    cores = len(os.sched_getaffinity(0))
+    venv = GroupedVecEnv([env_fn] * n_envs, cores) if n_envs > 1 else DummyVecEnv([env_fn])
+    venv.seed(0)
     venv = VecNormalize(venv, norm_obs=False, norm_reward=True)
     cfg = PPORunConfig(init=Path("unused"), envs=n_envs, rollout_steps=64, batch_size=64)
     model = make_model(cfg, venv, module, Path(tempfile.mkdtemp()), "cpu")
@@ -91,7 +92,7 @@ def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> Row:
         "ratio",
         0.8,
         detail=[
-            f"PPO sampling, {n_envs} subprocess envs {statistics.median(rl):9,.0f} steps/s",
+            f"PPO sampling, {n_envs} envs            {statistics.median(rl):9,.0f} steps/s",
             f"bound: {min(n_envs, cores)} x bare JSBSim      "
             f"{statistics.median(physics):9,.0f} steps/s",
         ],

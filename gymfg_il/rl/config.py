@@ -32,8 +32,8 @@ class PPORunConfig:
         turbulence: the air to train in: none, light, moderate or severe (default: the
             starting policy's; a change is printed as a note).
         wind_kt: a steady wind (knots) to train in (default: the starting policy's).
-        envs: environments sampled in parallel, one process each (0: four per CPU core, which
-            samples about twice as fast as one per core: ``benchmarks.rl``).
+        envs: environments sampled in parallel, in one process per CPU core (0: four per
+            core; ``benchmarks.rl`` measures the sampling rate).
         seed: seeds the envs (env k starts from seed + k), the sampling and the networks; a
             run with the same settings and the same number of envs repeats exactly (give
             --envs to repeat a run on a machine with other cores).
@@ -49,6 +49,8 @@ class PPORunConfig:
         batch_size: samples per gradient step.
         epochs: passes over each rollout per update.
         lr: Adam learning rate of the critic.
+        lr_schedule: ``constant``, or ``linear``: both learning rates fall linearly to 0 by
+            the end of the run, so the last updates move the policy less.
         actor_lr: Adam learning rate of the actor (default: lr).
         gamma: discount.
         gae_lambda: GAE's lambda.
@@ -99,6 +101,7 @@ class PPORunConfig:
     batch_size: int = 512
     epochs: int = 10
     lr: float = 3e-4
+    lr_schedule: Literal["constant", "linear"] = "constant"
     actor_lr: float | None = None
     gamma: float = 0.99
     gae_lambda: float = 0.95

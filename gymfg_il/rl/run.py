@@ -4,7 +4,8 @@ The actor starts as the cloned MLP (``rl.policy``); the envs are the policy's ow
 aircraft, task, rate and episode time; the weather may be changed), several processes, seeded
 per env so that a run repeats (``rl.env``). Every ``eval_every`` env steps the actor's mean
 action flies the same held-out seeds (``rl.judge``); the first evaluation, before any update,
-is the starting policy, and the controller flies those seeds once beside it. The result is
+is the starting policy, and the controller flies those seeds once beside it. The envs run in
+one process per core, each stepping its share of them (``rl.vec``). The result is
 one of our policy checkpoints (type ``ppo``, the MLP's network), with its learning curve
 (``curve.png``, ``curve.json``) and stable-baselines3's TensorBoard log (``tensorboard/``).
 
@@ -17,6 +18,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import os
 import shutil
 import tempfile
 import time
@@ -29,6 +31,7 @@ from typing import Any
 import torch
 from stable_baselines3 import PPO
 from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.utils import LinearSchedule
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.rl.config import PPORunConfig
@@ -36,6 +39,7 @@ from gymfg_il.rl.env import make_env
 from gymfg_il.rl.judge import EvalPoint, Judge, plot_curve
 from gymfg_il.rl.policy import AnchoredPolicy
 from gymfg_il.rl.start import Start, as_ppo, meta_of, starting_policy, stats_of
+from gymfg_il.rl.vec import GroupedVecEnv
 
 log = logging.getLogger(__name__)
 
@@ -74,7 +78,7 @@ def _train(
     on_eval: Callable[[EvalPoint], None] | None,
     start: Start,
 ) -> PPOResult:
-    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
     from gymfg_il.learning.config import resolve_device
     from gymfg_il.policies.checkpoint_folder import check_out
@@ -100,7 +104,8 @@ def _train(
             cfg.success_bonus,
         )
         n = cfg.n_envs
-        venv: Any = (SubprocVecEnv if n > 1 else DummyVecEnv)([env_fn] * n)
+        cores = len(os.sched_getaffinity(0))
+        venv: Any = GroupedVecEnv([env_fn] * n, cores) if n > 1 else DummyVecEnv([env_fn])
         venv.seed(cfg.seed)  # env k's first reset takes seed + k
         # rewards scaled by the running spread of the discounted return, never clipped (the
         # success bonus comes as one large reward)
@@ -169,7 +174,7 @@ def make_model(cfg: PPORunConfig, venv: Any, module: Any, tensorboard: Path, dev
     model = FineTunePPO(
         AnchoredPolicy,
         venv,
-        learning_rate=cfg.lr,
+        learning_rate=LinearSchedule(cfg.lr, 0.0, 1.0) if cfg.lr_schedule == "linear" else cfg.lr,
         n_steps=cfg.rollout_steps,
         batch_size=cfg.batch_size,
         n_epochs=cfg.epochs,
