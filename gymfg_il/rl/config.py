@@ -49,8 +49,6 @@ class PPORunConfig:
         batch_size: samples per gradient step.
         epochs: passes over each rollout per update.
         lr: Adam learning rate of the critic.
-        lr_schedule: ``constant``, or ``linear``: both learning rates fall linearly to 0 by
-            the end of the run, so the last updates move the policy less.
         actor_lr: Adam learning rate of the actor (default: lr).
         gamma: discount.
         gae_lambda: GAE's lambda.
@@ -101,7 +99,6 @@ class PPORunConfig:
     batch_size: int = 512
     epochs: int = 10
     lr: float = 3e-4
-    lr_schedule: Literal["constant", "linear"] = "constant"
     actor_lr: float | None = None
     gamma: float = 0.99
     gae_lambda: float = 0.95

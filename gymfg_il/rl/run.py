@@ -31,7 +31,6 @@ from typing import Any
 import torch
 from stable_baselines3 import PPO
 from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.utils import LinearSchedule
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.rl.config import PPORunConfig
@@ -174,7 +173,7 @@ def make_model(cfg: PPORunConfig, venv: Any, module: Any, tensorboard: Path, dev
     model = FineTunePPO(
         AnchoredPolicy,
         venv,
-        learning_rate=LinearSchedule(cfg.lr, 0.0, 1.0) if cfg.lr_schedule == "linear" else cfg.lr,
+        learning_rate=cfg.lr,
         n_steps=cfg.rollout_steps,
         batch_size=cfg.batch_size,
         n_epochs=cfg.epochs,
