@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import multiprocessing as mp
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -32,63 +33,79 @@ from stable_baselines3.common.vec_env.base_vec_env import (
 
 
 def _step(env: gym.Env, action: np.ndarray) -> tuple[Any, float, bool, dict[str, Any], Any]:
-    """One env's step as stable-baselines3's vector envs give it (resetting a finished one)."""
+    """One env's step as stable-baselines3's vector envs give it (resetting a finished one;
+    the reset's info, else None)."""
     obs, reward, terminated, truncated, info = env.step(action)
     done = terminated or truncated
     info["TimeLimit.truncated"] = truncated and not terminated
-    reset_info: dict[str, Any] = {}
+    reset_info = None
     if done:
         info["terminal_observation"] = obs
         obs, reset_info = env.reset()
     return obs, float(reward), done, info, reset_info
 
 
-def _worker(remote: Any, parent: Any, fns: CloudpickleWrapper) -> None:
-    """A group's process: builds its envs, then answers commands for all of them at once."""
+def _answer(envs: list[gym.Env], cmd: str, data: Any) -> Any:
+    """What a group's process answers to ``cmd`` (``data``: the command's arguments)."""
     from stable_baselines3.common.env_util import is_wrapped
 
+    if cmd == "step":
+        out = [_step(env, a) for env, a in zip(envs, data, strict=True)]
+        obs, rewards, dones, infos, resets = zip(*out, strict=True)
+        return np.stack(obs), np.array(rewards), np.array(dones), infos, resets
+    if cmd == "reset":
+        done = [
+            env.reset(seed=seed, **({"options": opt} if opt else {}))
+            for env, (seed, opt) in zip(envs, data, strict=True)
+        ]
+        obs, infos = zip(*done, strict=True)
+        return np.stack(obs), infos
+    if cmd == "spaces":
+        return envs[0].observation_space, envs[0].action_space
+    if cmd == "render":
+        return [env.render() for env in envs]
+    at, *rest = data
+    if cmd == "get_attr":
+        return [envs[i].get_wrapper_attr(rest[0]) for i in at]
+    if cmd == "has_attr":
+        return [envs[i].has_wrapper_attr(rest[0]) for i in at]
+    if cmd == "set_attr":
+        for i in at:
+            setattr(envs[i], rest[0], rest[1])
+        return [None] * len(at)
+    if cmd == "env_method":
+        name, args, kwargs = rest
+        return [envs[i].get_wrapper_attr(name)(*args, **kwargs) for i in at]
+    if cmd == "is_wrapped":
+        return [is_wrapped(envs[i], rest[0]) for i in at]
+    raise NotImplementedError(f"{cmd!r} is no command of a GroupedVecEnv worker")
+
+
+def _worker(remote: Any, parent: Any, fns: CloudpickleWrapper) -> None:
+    """A group's process: builds its envs, then answers commands for all of them at once. An
+    error goes back to the parent, which raises it; the process goes on."""
     parent.close()
-    envs: list[gym.Env] = [fn() for fn in fns.var]
+    envs: list[gym.Env] = []
     try:
+        envs = [fn() for fn in fns.var]
         while True:
+            cmd, data = remote.recv()
+            if cmd == "close":
+                return
             try:
-                cmd, data = remote.recv()
-            except (EOFError, KeyboardInterrupt):
-                return
-            if cmd == "step":
-                out = [_step(env, a) for env, a in zip(envs, data, strict=True)]
-                obs, rewards, dones, infos, resets = zip(*out, strict=True)
-                remote.send((np.stack(obs), np.array(rewards), np.array(dones), infos, resets))
-            elif cmd == "reset":
-                done = [
-                    env.reset(seed=seed, **({"options": opt} if opt else {}))
-                    for env, (seed, opt) in zip(envs, data, strict=True)
-                ]
-                obs, infos = zip(*done, strict=True)
-                remote.send((np.stack(obs), infos))
-            elif cmd == "close":
-                remote.close()
-                return
-            elif cmd == "spaces":
-                remote.send((envs[0].observation_space, envs[0].action_space))
-            elif cmd == "get_attr":
-                remote.send([envs[i].get_wrapper_attr(data[1]) for i in data[0]])
-            elif cmd == "set_attr":
-                for i in data[0]:
-                    setattr(envs[i], data[1], data[2])
-                remote.send(None)
-            elif cmd == "env_method":
-                at, name, args, kwargs = data
-                remote.send([envs[i].get_wrapper_attr(name)(*args, **kwargs) for i in at])
-            elif cmd == "is_wrapped":
-                remote.send([is_wrapped(envs[i], data[1]) for i in data[0]])
-            elif cmd == "render":
-                remote.send([env.render() for env in envs])
-            else:
-                raise NotImplementedError(f"{cmd!r} is no command of a GroupedVecEnv worker")
+                reply: tuple[bool, Any] = (True, _answer(envs, cmd, data))
+            except Exception as err:  # the parent raises it
+                reply = (False, err)
+            try:
+                remote.send(reply)
+            except Exception as err:  # an answer or an error that cannot be pickled
+                remote.send((False, RuntimeError(f"{cmd}: {err!r}")))
+    except (EOFError, KeyboardInterrupt, BrokenPipeError):
+        return
     finally:
         for env in envs:
             env.close()
+        remote.close()
 
 
 def groups_of(n_envs: int, processes: int) -> list[range]:
@@ -103,8 +120,9 @@ def groups_of(n_envs: int, processes: int) -> list[range]:
 
 class GroupedVecEnv(VecEnv):
     """stable-baselines3's vector env over ``env_fns`` in ``processes`` processes (module
-    docstring). The processes start by forkserver (or spawn), so a script that builds one
-    runs under ``if __name__ == "__main__":``."""
+    docstring), for envs with a Box observation. The processes start by forkserver (or
+    spawn), so a script that builds one runs under ``if __name__ == "__main__":``. An error
+    in an env is raised here, with the env's own message."""
 
     def __init__(self, env_fns: Sequence[Callable[[], gym.Env]], processes: int) -> None:
         method = "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
@@ -112,18 +130,41 @@ class GroupedVecEnv(VecEnv):
         self.groups = groups_of(len(env_fns), processes)
         self.remotes: list[Any] = []
         self.processes: list[Any] = []
-        for group in self.groups:
-            remote, work = ctx.Pipe()
-            fns = CloudpickleWrapper([env_fns[i] for i in group])
-            process = ctx.Process(target=_worker, args=(work, remote, fns), daemon=True)
-            process.start()
-            work.close()
-            self.remotes.append(remote)
-            self.processes.append(process)
         self.waiting, self.closed = False, False
-        self.remotes[0].send(("spaces", None))
-        observation_space, action_space = self.remotes[0].recv()
+        try:
+            for group in self.groups:
+                remote, work = ctx.Pipe()
+                fns = CloudpickleWrapper([env_fns[i] for i in group])
+                process = ctx.Process(target=_worker, args=(work, remote, fns), daemon=True)
+                process.start()
+                work.close()
+                self.remotes.append(remote)
+                self.processes.append(process)
+            self.remotes[0].send(("spaces", None))
+            ((observation_space, action_space),) = self._recv_all(self.remotes[:1])
+        except BaseException:
+            self.close()
+            raise
+        if not isinstance(observation_space, gym.spaces.Box):
+            self.close()
+            raise TypeError(f"GroupedVecEnv stacks Box observations, not {observation_space}")
         super().__init__(len(env_fns), observation_space, action_space)
+        self.reset_infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
+
+    @staticmethod
+    def _recv_all(remotes: Sequence[Any]) -> list[Any]:
+        """Every group's answer, all read before the first error there is raised here (an
+        unread answer would answer the next command)."""
+        replies = []
+        for remote in remotes:
+            try:
+                replies.append(remote.recv())
+            except EOFError:
+                replies.append((False, RuntimeError("an env process of GroupedVecEnv ended")))
+        for ok, answer in replies:
+            if not ok:
+                raise answer
+        return [answer for _, answer in replies]
 
     def step_async(self, actions: np.ndarray) -> None:
         for remote, group in zip(self.remotes, self.groups, strict=True):
@@ -131,17 +172,22 @@ class GroupedVecEnv(VecEnv):
         self.waiting = True
 
     def step_wait(self) -> VecEnvStepReturn:
-        results = [remote.recv() for remote in self.remotes]
-        self.waiting = False
+        try:
+            results = self._recv_all(self.remotes)
+        finally:
+            self.waiting = False
         obs, rewards, dones, infos, resets = zip(*results, strict=True)
-        self.reset_infos = [info for group in resets for info in group]
+        # as stable-baselines3's envs: each env's last reset info, until it resets again
+        for i, reset_info in enumerate(r for group in resets for r in group):
+            if reset_info is not None:
+                self.reset_infos[i] = reset_info
         flat = [info for group in infos for info in group]
         return np.concatenate(obs), np.concatenate(rewards), np.concatenate(dones), flat
 
     def reset(self) -> VecEnvObs:
         for remote, group in zip(self.remotes, self.groups, strict=True):
             remote.send(("reset", [(self._seeds[i], self._options[i]) for i in group]))
-        results = [remote.recv() for remote in self.remotes]
+        results = self._recv_all(self.remotes)
         obs, infos = zip(*results, strict=True)
         self.reset_infos = [info for group in infos for info in group]
         self._reset_seeds()
@@ -149,22 +195,28 @@ class GroupedVecEnv(VecEnv):
         return np.concatenate(obs)
 
     def close(self) -> None:
+        """Ends the env processes (those that no longer answer too) and closes the pipes."""
         if self.closed:
             return
-        if self.waiting:
-            for remote in self.remotes:
-                remote.recv()
+        self.closed = True
         for remote in self.remotes:
-            remote.send(("close", None))
+            try:
+                if self.waiting:
+                    remote.recv()
+                remote.send(("close", None))
+            except (EOFError, OSError):
+                pass  # that process has ended already
         for process in self.processes:
-            process.join()
+            process.join(timeout=10)
+            if process.is_alive():
+                process.terminate()
+                process.join()
         for remote in self.remotes:
             remote.close()
-        self.closed = True
 
     def _ask(self, cmd: str, indices: VecEnvIndices, *data: Any) -> list[Any]:
         """``cmd`` on the envs at ``indices``, each group asked once; the answers in env order."""
-        wanted = list(self._get_indices(indices))
+        wanted = [range(self.num_envs)[i] for i in self._get_indices(indices)]
         asked = []
         for remote, group in zip(self.remotes, self.groups, strict=True):
             mine = [i - group.start for i in wanted if i in group]
@@ -172,9 +224,13 @@ class GroupedVecEnv(VecEnv):
                 remote.send((cmd, (mine, *data)))
                 asked.append((remote, [group.start + i for i in mine]))
         answers: dict[int, Any] = {}
-        for remote, at in asked:
-            answers.update(zip(at, remote.recv() or [None] * len(at), strict=True))
+        replies = self._recv_all([remote for remote, _ in asked])
+        for (_, at), reply in zip(asked, replies, strict=True):
+            answers.update(zip(at, reply, strict=True))
         return [answers[i] for i in wanted]
+
+    def has_attr(self, attr_name: str) -> bool:
+        return all(self._ask("has_attr", None, attr_name))
 
     def get_attr(self, attr_name: str, indices: VecEnvIndices = None) -> list[Any]:
         return self._ask("get_attr", indices, attr_name)
@@ -197,6 +253,11 @@ class GroupedVecEnv(VecEnv):
         return self._ask("is_wrapped", indices, wrapper_class)
 
     def get_images(self) -> Sequence[np.ndarray | None]:
+        if self.render_mode != "rgb_array":
+            warnings.warn(
+                f"the render mode is {self.render_mode}; images need rgb_array", stacklevel=2
+            )
+            return [None] * self.num_envs
         for remote in self.remotes:
             remote.send(("render", None))
-        return [image for remote in self.remotes for image in remote.recv()]
+        return [image for group in self._recv_all(self.remotes) for image in group]

@@ -2,14 +2,16 @@
 
 A task's judge measures each error its success rule bounds, over the span the rule judges
 (``Measure``: the error's worst moment there, or its mean where the rule averages it as in
-turbulence, and the tolerance the rule allows; each task's docstring names its measures in its
-``Grade:`` sentence). The grade is ``unsatisfactory`` when the verdict is a failure. A success
-is graded as an instructor grades a check ride, by how much of its tolerance the worst
-excursion used: within ``SHARES[0]`` (a quarter) of every tolerance ``excellent``, within
-``SHARES[1]`` (half) ``good``, beyond that ``fair`` (passed). The worst moment grades, not the
-RMS error: on the approach every tier of synthetic pilot tracked within about a tenth of the
-tolerances RMS, so RMS graded the novice tier, whose worst excursions used a third of the
-tolerances and more, as excellent as the expert tier (docs/results/capture.md).
+turbulence, and the tolerance the rule allows), and may add what an instructor grades but no
+rule fails (the approach: the bank on final, of the 15 deg a stabilized final allows); each
+task's docstring names its measures in its ``Grade:`` sentence. The grade is
+``unsatisfactory`` when the verdict is a failure. A success is graded as an instructor grades
+a check ride, by how much of its tolerance the worst excursion used: within ``SHARES[0]``
+(a quarter) of every tolerance ``excellent``, within ``SHARES[1]`` (half) ``good``, beyond
+that ``fair`` (passed). The worst moment grades, not the RMS error: on the approach every
+tier of synthetic pilot tracked within about a tenth of the tolerances RMS, so RMS graded the
+novice tier, whose worst excursions used a third of the tolerances and more, as excellent as
+the expert tier (docs/results/capture.md).
 """
 
 from __future__ import annotations

@@ -104,3 +104,6 @@ def test_the_approach_grades_the_bank_on_final_but_does_not_fail_it():
     banked = ApproachTask.judge(plan, states, ep.dt)
     assert banked.success and banked.measures[:3] == flown.measures[:3]
     assert banked.measures[-1].value == 10.0 and banked.grade == "fair"
+    # in turbulence the bank grades by its mean over the final, as the other measures do
+    gusty = ApproachTask.judge(plan, states, ep.dt, gusty=True).measures[-1]
+    assert (gusty.kind, gusty.value) == ("mean", 10.0)
