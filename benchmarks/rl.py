@@ -47,7 +47,7 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     venv.seed(0)
     venv = VecNormalize(venv, norm_obs=False, norm_reward=True)
     cfg = PPORunConfig(init=Path("unused"), envs=n_envs, rollout_steps=64, batch_size=64)
-    model = make_model(cfg, venv, module, Path(tempfile.mkdtemp()), "cpu")
+    model = make_model(cfg, venv, module, Path(tempfile.mkdtemp()), "cpu", flight.agent_hz)
     model.tensorboard_log = None
     _, callback = model._setup_learn(10**9, callback=None)
 

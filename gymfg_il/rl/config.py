@@ -13,6 +13,8 @@ from gymfg_il.sim.weather import Turbulence
 from gymfg_il.typecheck import type_problems
 
 ANCHOR_SPAN_MAX = 150_000  # the longest the anchor decays over by default (``anchor_steps``)
+# the default discount and GAE lambda per step at DISCOUNT_HZ, kept per second at other rates
+DEFAULT_GAMMA, DEFAULT_GAE_LAMBDA, DISCOUNT_HZ = 0.99, 0.95, 10
 
 
 @dataclass
@@ -50,8 +52,10 @@ class PPORunConfig:
         epochs: passes over each rollout per update.
         lr: Adam learning rate of the critic.
         actor_lr: Adam learning rate of the actor (default: lr).
-        gamma: discount.
-        gae_lambda: GAE's lambda.
+        gamma: discount per step (default: 0.99 at 10 Hz, and at other agent rates the same
+            decay per second, 0.99 ** (10 / Hz): 0.9967 at 30 Hz; at 30 Hz a plain 0.99 sees
+            3 s ahead, and a fine-tuned turn learnt to crash; docs/results/rl.md).
+        gae_lambda: GAE's lambda per step (default: 0.95 at 10 Hz, likewise per second).
         clip_range: PPO's clip on the probability ratio.
         target_kl: an update stops early when its KL divergence from the sampling policy
             passes 1.5 x this (0: never).
@@ -100,8 +104,8 @@ class PPORunConfig:
     epochs: int = 10
     lr: float = 3e-4
     actor_lr: float | None = None
-    gamma: float = 0.99
-    gae_lambda: float = 0.95
+    gamma: float | None = None
+    gae_lambda: float | None = None
     clip_range: float = 0.2
     target_kl: float = 0.02
     exploration: Literal["sde", "gaussian"] = "sde"
@@ -140,8 +144,9 @@ class PPORunConfig:
         if self.actor_lr is not None and not 0 < self.actor_lr < 1:
             problems.append(f"actor_lr={self.actor_lr} must lie in (0, 1)")
         for name in ("gamma", "gae_lambda"):
-            if not 0 < getattr(self, name) <= 1:
-                problems.append(f"{name}={getattr(self, name)} must lie in (0, 1]")
+            value = getattr(self, name)
+            if value is not None and not 0 < value <= 1:
+                problems.append(f"{name}={value} must lie in (0, 1]")
         if not 0 < self.clip_range < 1:
             problems.append(f"clip_range={self.clip_range} must lie in (0, 1)")
         for name in ("target_kl", "anchor", "success_bonus"):
@@ -181,6 +186,14 @@ class PPORunConfig:
         if self.critic_warmup is not None:
             return self.critic_warmup
         return max(self.rollout, min(20_000, self.steps // 10))
+
+    def discounts(self, agent_hz: int) -> tuple[float, float]:
+        """(gamma, GAE lambda) for a flight at ``agent_hz``: as given, else the decay per
+        second of 0.99 and 0.95 a step at ``DISCOUNT_HZ``."""
+        k = DISCOUNT_HZ / agent_hz
+        gamma = self.gamma if self.gamma is not None else DEFAULT_GAMMA**k
+        lam = self.gae_lambda if self.gae_lambda is not None else DEFAULT_GAE_LAMBDA**k
+        return gamma, lam
 
     @property
     def anchor_span(self) -> int:

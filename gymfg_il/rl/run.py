@@ -108,12 +108,18 @@ def _train(
         venv.seed(cfg.seed)  # env k's first reset takes seed + k
         # rewards scaled by the running spread of the discounted return, never clipped (the
         # success bonus comes as one large reward)
+        gamma, _ = cfg.discounts(flight.agent_hz)
         venv = VecNormalize(
-            venv, norm_obs=False, norm_reward=True, gamma=cfg.gamma, clip_reward=math.inf
+            venv, norm_obs=False, norm_reward=True, gamma=gamma, clip_reward=math.inf
         )
         try:
             model = make_model(
-                cfg, venv, module, scratch_dir / "tensorboard", resolve_device(cfg.device)
+                cfg,
+                venv,
+                module,
+                scratch_dir / "tensorboard",
+                resolve_device(cfg.device),
+                flight.agent_hz,
             )
             watch = _Watch(cfg, judge, curve, on_steps, on_eval)
             model.learn(cfg.steps, callback=watch, tb_log_name="ppo", progress_bar=False)
@@ -164,8 +170,12 @@ class FineTunePPO(PPO):
         super().train()
 
 
-def make_model(cfg: PPORunConfig, venv: Any, module: Any, tensorboard: Path, device: str) -> Any:
-    """stable-baselines3's PPO with the cloned actor, the critic warm-up and the anchor."""
+def make_model(
+    cfg: PPORunConfig, venv: Any, module: Any, tensorboard: Path, device: str, agent_hz: int
+) -> Any:
+    """stable-baselines3's PPO with the cloned actor, the critic warm-up and the anchor, for
+    a flight at ``agent_hz`` (the discount's rate)."""
+    gamma, gae_lambda = cfg.discounts(agent_hz)
     sde = cfg.exploration == "sde"
     # gSDE's noise on one control sums one term per observed variable (each of about unit
     # spread, normalised): its spread is about sqrt(n) x the matrix's
@@ -177,8 +187,8 @@ def make_model(cfg: PPORunConfig, venv: Any, module: Any, tensorboard: Path, dev
         n_steps=cfg.rollout_steps,
         batch_size=cfg.batch_size,
         n_epochs=cfg.epochs,
-        gamma=cfg.gamma,
-        gae_lambda=cfg.gae_lambda,
+        gamma=gamma,
+        gae_lambda=gae_lambda,
         clip_range=cfg.clip_range,
         target_kl=cfg.target_kl or None,
         ent_coef=0.0,
@@ -256,6 +266,7 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, tb: Pa
     flight = start.flight
     name = Path(result.out).name
     settings = {k: str(v) if isinstance(v, Path) else v for k, v in asdict(cfg).items()}
+    settings["gamma"], settings["gae_lambda"] = cfg.discounts(flight.agent_hz)
     rl = {
         "algorithm": "ppo (stable-baselines3)",
         "init": str(cfg.init) if cfg.init else None,

@@ -48,7 +48,7 @@ def test_the_actor_starts_as_the_cloned_policy(bc_policy, tmp_path):
     spec = start.flight.to_dict()
     venv = DummyVecEnv([lambda: make_env(spec, action["mean"], action["std"])])
     try:
-        model = make_model(cfg, venv, start.module, tmp_path / "tb", "cpu")
+        model = make_model(cfg, venv, start.module, tmp_path / "tb", "cpu", start.flight.agent_hz)
         env = start.flight.make_env()
         bc = PolicyAgent.load(bc_policy)
         for seed in (5, 6, 7):
@@ -146,7 +146,7 @@ def test_the_critic_warms_up_before_the_actor_moves(bc_policy, tmp_path):
     action = stats_of(start.module, "action_norm")
     spec = start.flight.to_dict()
     venv = DummyVecEnv([lambda: make_env(spec, action["mean"], action["std"], 0.2)])
-    model = make_model(cfg, venv, start.module, tmp_path / "tb", "cpu")
+    model = make_model(cfg, venv, start.module, tmp_path / "tb", "cpu", start.flight.agent_hz)
 
     def weights(module):
         return [p.detach().clone() for p in module.parameters()]
@@ -169,6 +169,19 @@ def test_the_anchor_lets_go_within_150k_steps_unless_told(bc_policy):
     assert spans == [50_000, 150_000]
     assert PPORunConfig(init=bc_policy, steps=1_000_000).anchor_span == 150_000
     assert PPORunConfig(init=bc_policy, steps=10**6, anchor_steps=500_000).anchor_span == 500_000
+
+
+def test_the_discount_looks_as_far_ahead_in_seconds_at_every_rate(bc_policy):
+    cfg = PPORunConfig(init=bc_policy)
+    assert cfg.discounts(10) == (0.99, 0.95)  # the 10 Hz defaults, as they always were
+    gamma, lam = cfg.discounts(30)
+    # after one second, a reward counts as much at 30 Hz as at 10 Hz
+    assert gamma**30 == pytest.approx(0.99**10) and lam**30 == pytest.approx(0.95**10)
+    assert gamma == pytest.approx(0.99665, abs=1e-5)
+    given = PPORunConfig(init=bc_policy, gamma=0.98, gae_lambda=0.9)
+    assert given.discounts(30) == (0.98, 0.9)
+    with pytest.raises(ConfigError, match=r"gamma=1\.5"):
+        PPORunConfig(init=bc_policy, gamma=1.5)
 
 
 def test_what_cannot_be_fine_tuned_is_refused(bc_policy, tiny_dataset, tmp_path):
