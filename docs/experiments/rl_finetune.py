@@ -3,7 +3,10 @@
 For each task folder under OUT: success and return on the held-out seeds (eval.json) of the
 controller, the BC start, the fine-tuned policy and PPO from scratch; the fine-tuning's lowest
 evaluation against its start (the collapse check, on the run's own 16 seeds, every 50k
-steps); env steps and wall time. The curves go to PNG (default docs/images/rl_curves.png).
+steps); env steps and wall time. With several fine-tuning seeds (``ppo``, ``ppo-s1``, ...,
+rl_finetune.sh's SEEDS), the fine-tuned cell is the worst run (by held-out success) with the
+mean over the runs beside it, and the collapse check the worst of them. The curves go to PNG
+(default docs/images/rl_curves.png).
 """
 
 from __future__ import annotations
@@ -18,6 +21,12 @@ TASKS = ("altitude", "heading", "approach", "turn")
 def _rows(folder: Path) -> dict[str, dict]:
     rows = json.loads((folder / "eval.json").read_text())["rows"]
     return {r["agent"].split(":")[-1]: r for r in rows}
+
+
+def _tuned(folder: Path) -> list[str]:
+    """The fine-tuning runs of a task folder: ppo (seed 0), then ppo-s1, ppo-s2, ..."""
+    names = [p.name for p in folder.glob("ppo-s*") if (p / "curve.json").is_file()]
+    return ["ppo", *sorted(names, key=lambda n: int(n.removeprefix("ppo-s")))]
 
 
 def _curve(folder: Path) -> dict | None:
@@ -46,15 +55,23 @@ def table(out: Path) -> list[str]:
             crashed = f", {r['terminated']} ended early" if r["terminated"] else ""
             return f"{100 * r['success_rate']:.0f}% ({r['mean_return']:.0f}{crashed})"
 
-        dip = "-"
-        if ppo:
-            start = ppo["curve"][0]["success"]
-            low = min(p["success"] for p in ppo["curve"])
-            dip = f"{100 * (low - start):+.0f} pp"
+        runs = [name for name in _tuned(folder) if name in rows]
+        tuned = cell("ppo")
+        if len(runs) > 1:
+            worst = min(runs, key=lambda name: rows[name]["success_rate"])
+            mean = sum(rows[name]["success_rate"] for name in runs) / len(runs)
+            tuned = f"worst {cell(worst)}; mean {100 * mean:.0f}% of {len(runs)} seeds"
+        dips = []
+        for name in runs:
+            c = _curve(folder / name)
+            if c:
+                start = c["curve"][0]["success"]
+                dips.append(min(p["success"] for p in c["curve"]) - start)
+        dip = f"{100 * min(dips):+.0f} pp" if dips else "-"
         steps = f"{ppo['steps']:,}" if ppo else "-"
         walls = ", ".join(f"{c['wall_s'] / 60:.0f} min" if c else "-" for c in (ppo, scratch))
         lines.append(
-            f"| {task} | {air} | {cell('controller')} | {cell('bc')} | {cell('ppo')} | "
+            f"| {task} | {air} | {cell('controller')} | {cell('bc')} | {tuned} | "
             f"{cell('scratch')} | {dip} | {steps} | {walls} |"
         )
     return lines
@@ -70,13 +87,17 @@ def plot(out: Path, png: Path) -> None:
     tasks = [t for t in TASKS if _curve(out / t / "ppo")]
     fig, axes = plt.subplots(1, len(tasks), figsize=(4 * len(tasks), 3.4), squeeze=False)
     for ax, task in zip(axes[0], tasks, strict=True):
-        for name, style in (("ppo", "-o"), ("scratch", "-s")):
+        runs = _tuned(out / task)
+        for name in (*runs, "scratch"):
             c = _curve(out / task / name)
             if c is None:
                 continue
             steps = [p["step"] for p in c["curve"]]
-            ax.plot(steps, [100 * p["success"] for p in c["curve"]], style, ms=3,
-                    label="fine-tuned" if name == "ppo" else "from scratch")  # fmt: skip
+            label = "from scratch" if name == "scratch" else "fine-tuned"
+            if name != "scratch" and len(runs) > 1:
+                label += f", seed {c['settings']['seed']}"
+            ax.plot(steps, [100 * p["success"] for p in c["curve"]],
+                    "-s" if name == "scratch" else "-o", ms=3, label=label)  # fmt: skip
         c = _curve(out / task / "ppo")
         ax.axhline(100 * c["curve"][0]["success"], color="grey", ls="--", label="BC start")
         ax.axhline(100 * c["controller"]["success"], color="green", ls=":", label="controller")
