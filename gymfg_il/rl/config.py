@@ -13,6 +13,8 @@ from gymfg_il.sim.weather import Turbulence
 from gymfg_il.typecheck import type_problems
 
 ANCHOR_SPAN_MAX = 150_000  # the longest the anchor decays over by default (``anchor_steps``)
+# the actor's default learning rate when fine-tuning (``actor_lr``); from scratch it is ``lr``
+FINE_TUNE_ACTOR_LR = 1e-4
 # the default discount and GAE lambda per step at DISCOUNT_HZ, kept per second at other rates
 DEFAULT_GAMMA, DEFAULT_GAE_LAMBDA, DISCOUNT_HZ = 0.99, 0.95, 10
 
@@ -51,7 +53,9 @@ class PPORunConfig:
         batch_size: samples per gradient step.
         epochs: passes over each rollout per update.
         lr: Adam learning rate of the critic.
-        actor_lr: Adam learning rate of the actor (default: lr).
+        actor_lr: Adam learning rate of the actor (default: 1e-4 when fine-tuning, a third of
+            the critic's: at lr, runs in turbulence fell 6-12 points below their start and
+            crashed late, and at 1e-4 none fell below it, docs/results/rl.md; from scratch: lr).
         gamma: discount per step (default: 0.99 at 10 Hz, and at other agent rates the same
             decay per second, 0.99 ** (10 / Hz): 0.9967 at 30 Hz; at 30 Hz a plain 0.99 sees
             3 s ahead, and a fine-tuned turn learnt to crash; docs/results/rl.md).
@@ -179,7 +183,10 @@ class PPORunConfig:
 
     @property
     def actor_rate(self) -> float:
-        return self.lr if self.actor_lr is None else self.actor_lr
+        """The actor's learning rate: ``actor_lr``, else 1e-4 when fine-tuning, else ``lr``."""
+        if self.actor_lr is not None:
+            return self.actor_lr
+        return FINE_TUNE_ACTOR_LR if self.init is not None else self.lr
 
     @property
     def warmup_steps(self) -> int:

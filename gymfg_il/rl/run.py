@@ -267,6 +267,7 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, tb: Pa
     name = Path(result.out).name
     settings = {k: str(v) if isinstance(v, Path) else v for k, v in asdict(cfg).items()}
     settings["gamma"], settings["gae_lambda"] = cfg.discounts(flight.agent_hz)
+    settings["actor_lr"] = cfg.actor_rate
     rl = {
         "algorithm": "ppo (stable-baselines3)",
         "init": str(cfg.init) if cfg.init else None,

@@ -83,6 +83,7 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     assert config["type"] == "ppo" and config["policy"]["hidden"] == [256, 256]
     assert config["spec"]["turbulence"] == "light"
     assert config["rl"]["init"] == str(bc_policy) and config["train"]  # DAgger retrains on it
+    assert config["rl"]["settings"]["actor_lr"] == 1e-4  # the rate applied, not None
     assert (out / "curve.png").stat().st_size > 1000
     assert list((out / "tensorboard").rglob("events.out.tfevents.*"))
     # the best evaluation's actor is kept (the start's, where nothing beat it)
@@ -169,6 +170,14 @@ def test_the_anchor_lets_go_within_150k_steps_unless_told(bc_policy):
     assert spans == [50_000, 150_000]
     assert PPORunConfig(init=bc_policy, steps=1_000_000).anchor_span == 150_000
     assert PPORunConfig(init=bc_policy, steps=10**6, anchor_steps=500_000).anchor_span == 500_000
+
+
+def test_a_fine_tuned_actor_learns_at_a_third_of_the_critics_rate(bc_policy):
+    # 1e-4 against 3e-4: at the critic's rate, runs in turbulence fell below their start
+    assert PPORunConfig(init=bc_policy).actor_rate == 1e-4
+    assert PPORunConfig(init=bc_policy, actor_lr=3e-4).actor_rate == 3e-4
+    scratch = PPORunConfig(task="altitude", aircraft="c172p")
+    assert scratch.actor_rate == scratch.lr == 3e-4  # a fresh actor has nothing to keep
 
 
 def test_the_discount_looks_as_far_ahead_in_seconds_at_every_rate(bc_policy):
