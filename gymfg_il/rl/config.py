@@ -53,9 +53,10 @@ class PPORunConfig:
         batch_size: samples per gradient step.
         epochs: passes over each rollout per update.
         lr: Adam learning rate of the critic.
-        actor_lr: Adam learning rate of the actor (default: 1e-4 when fine-tuning, a third of
-            the critic's, so that the cloned actor moves slower than the critic learns and
-            runs do not fall below their start, docs/results/rl.md; from scratch: lr).
+        actor_lr: Adam learning rate of the actor (default: 1e-4 when fine-tuning, whatever
+            --lr is, a third of the default critic's, so that the cloned actor moves slower
+            than the critic learns and runs do not fall below their start,
+            docs/results/rl.md; from scratch: lr).
         gamma: discount per step (default: 0.99 at 10 Hz, and at other agent rates the same
             decay per second, 0.99 ** (10 / Hz): 0.9967 at 30 Hz; at 30 Hz a plain 0.99 sees
             3 s ahead, and a fine-tuned turn learnt to crash; docs/results/rl.md).
