@@ -25,7 +25,7 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     from functools import partial
 
     import numpy as np
-    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+    from stable_baselines3.common.vec_env import VecNormalize
 
     from gymfg_il.envs.flight import FlightSpec
     from gymfg_il.policies.configuration_mlp import MLPConfig
@@ -33,7 +33,7 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     from gymfg_il.rl.config import PPORunConfig
     from gymfg_il.rl.env import make_env
     from gymfg_il.rl.run import make_model
-    from gymfg_il.rl.vec import GroupedVecEnv
+    from gymfg_il.rl.vec import training_envs
 
     flight = FlightSpec.solo("c172p", "altitude")
     env = flight.make_env()
@@ -42,8 +42,7 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     stats = [{"mean": np.zeros(n), "std": np.ones(n)} for n in (n_obs, 4)]
     module = MLPPolicy(MLPConfig(), *stats)
     env_fn = partial(make_env, flight.to_dict(), [0.0] * 4, [1.0] * 4, 0.2)
-    cores = len(os.sched_getaffinity(0))
-    venv = GroupedVecEnv([env_fn] * n_envs, cores) if n_envs > 1 else DummyVecEnv([env_fn])
+    venv = training_envs(env_fn, n_envs)
     venv.seed(0)
     venv = VecNormalize(venv, norm_obs=False, norm_reward=True)
     cfg = PPORunConfig(init=Path("unused"), envs=n_envs, rollout_steps=64, batch_size=64)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import multiprocessing as mp
+import os
 import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -261,3 +262,13 @@ class GroupedVecEnv(VecEnv):
         for remote in self.remotes:
             remote.send(("render", None))
         return [image for group in self._recv_all(self.remotes) for image in group]
+
+
+def training_envs(env_fn: Callable[[], gym.Env], n: int) -> VecEnv:
+    """``n`` envs built by ``env_fn``, as ``train ppo`` samples them: grouped in one process
+    per core (``GroupedVecEnv``), or a single env in this process."""
+    if n == 1:
+        from stable_baselines3.common.vec_env import DummyVecEnv
+
+        return DummyVecEnv([env_fn])
+    return GroupedVecEnv([env_fn] * n, len(os.sched_getaffinity(0)))
