@@ -80,6 +80,11 @@ class PPORunConfig:
             and a success adds this share of the episode's steps to its return (a step's task
             reward is at most about 1), so what PPO maximises includes what success measures
             (0: the task's reward alone).
+        clock: the critic sees the share of the episode flown, and the time limit ends an
+            episode's return instead of being bootstrapped past: the task is judged over its
+            last seconds and the bonus comes at the limit, so what a state is worth depends
+            on the time left (``rl.env.EpisodeClock``). The actor never sees it. Off by
+            default: in 1M-step runs it did not raise held-out success (docs/results/rl.md).
         anchor: weight, at the start, of the squared distance between the actor's mean action
             and the starting policy's (normalised units) added to PPO's loss; it decays
             linearly to 0 over anchor_steps (0: no anchor). Not used from scratch.
@@ -118,6 +123,7 @@ class PPORunConfig:
     action_std: float = 0.2
     critic_warmup: int | None = None
     success_bonus: float = 0.2
+    clock: bool = False
     anchor: float = 1.0
     anchor_steps: int | None = None
     critic: list[int] = field(default_factory=lambda: [256, 256])

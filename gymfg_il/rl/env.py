@@ -7,6 +7,7 @@ comes on the way there: a policy that reaches the target and then wanders outsid
 tolerance earns nearly the return of one that holds it (the c172p's altitude in moderate
 turbulence: the controller 580, a cloned policy 545, success 100 % against 56 %). The bonus
 puts the task's own verdict into the return, in the last steps, where the verdict is decided.
+The bonus comes at the time limit, so the critic is told the time (``EpisodeClock``).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import gymnasium as gym
 import numpy as np
 
 from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.sim.timing import episode_steps
 from gymfg_il.tasks.verdicts import judge_flight
 
 
@@ -93,15 +95,61 @@ class SuccessBonus(gym.Wrapper):
         return success
 
 
+class EpisodeClock(gym.Wrapper):
+    """Appends the share of the episode flown (0 at the reset, 1 at the time limit) to the
+    observation, and makes the time limit the episode's end (``terminated``), not a cut.
+
+    The task judges an episode over its last seconds and the success bonus comes at the time
+    limit: what an action is worth depends on the time left, which the flight's observation
+    does not hold. With the clock the critic can value it, and since the limit is part of the
+    task, its return ends there instead of being bootstrapped past it (Pardo et al. 2018,
+    "Time Limits in Reinforcement Learning"). The actor never sees the clock
+    (``rl.policy``): it flies as the cloned policy does, from the flight's observation."""
+
+    def __init__(self, env: gym.Env, steps: int) -> None:
+        super().__init__(env)
+        self.steps = steps
+        self._t = 0
+        box = env.observation_space
+        assert isinstance(box, gym.spaces.Box)
+        self.observation_space = gym.spaces.Box(
+            np.append(box.low, 0.0).astype(box.dtype),
+            np.append(box.high, 1.0).astype(box.dtype),
+            dtype=box.dtype,
+        )
+
+    def _timed(self, obs: np.ndarray) -> np.ndarray:
+        return np.append(obs, min(1.0, self._t / self.steps)).astype(obs.dtype)
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
+        obs, info = self.env.reset(**kwargs)
+        self._t = 0
+        return self._timed(obs), info
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self._t += 1
+        return self._timed(obs), float(reward), terminated or truncated, False, info
+
+
 def make_env(
-    spec: dict[str, Any], mean: list[float], std: list[float], success_bonus: float = 0.0
+    spec: dict[str, Any],
+    mean: list[float],
+    std: list[float],
+    success_bonus: float = 0.0,
+    clock: bool = False,
 ) -> gym.Env:
     """One training env (picklable, built in its own process): the flight ``spec`` taking
     actions in the policy's normalised units, its episodes' task returns logged
-    (stable-baselines3's ``Monitor``, ``rollout/ep_rew_mean``: without the bonus) and,
-    with ``success_bonus``, judged."""
+    (stable-baselines3's ``Monitor``, ``rollout/ep_rew_mean``: without the bonus), with
+    ``success_bonus`` judged, and with ``clock`` timed (``EpisodeClock``)."""
     from stable_baselines3.common.monitor import Monitor
 
-    env = FlightSpec.from_dict(spec).make_env()
+    flight = FlightSpec.from_dict(spec)
+    env = flight.make_env()
     out: gym.Env = Monitor(NormalizedActions(env, np.array(mean), np.array(std)))
-    return SuccessBonus(out, success_bonus) if success_bonus else out
+    if success_bonus:
+        out = SuccessBonus(out, success_bonus)
+    if clock:
+        out = EpisodeClock(out, episode_steps(flight.episode_time_s, flight.agent_hz))
+    return out

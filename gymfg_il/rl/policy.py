@@ -37,31 +37,36 @@ from gymfg_il.policies.normalize import Normalizer
 
 class _Pass(nn.Module):
     """stable-baselines3's ``mlp_extractor`` slot, left empty: actor and critic take the
-    raw observation and normalise it themselves."""
+    raw observation and normalise it themselves; the actor its first ``n_actor`` columns
+    (the flight's observation), the critic all of them (with ``rl.env.EpisodeClock``, the
+    time as well)."""
 
-    def __init__(self, width: int) -> None:
+    def __init__(self, width: int, n_actor: int) -> None:
         super().__init__()
-        self.latent_dim_pi = self.latent_dim_vf = width
+        self.latent_dim_pi, self.latent_dim_vf = n_actor, width
+        self.n_actor = n_actor
 
     def forward(self, x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        return x, x
+        return x[..., : self.n_actor], x
 
     def forward_actor(self, x: torch.Tensor) -> torch.Tensor:
-        return x
+        return x[..., : self.n_actor]
 
     def forward_critic(self, x: torch.Tensor) -> torch.Tensor:
         return x
 
 
 class Critic(nn.Module):
-    """The value network: the actor's observation normalisation (a copy, frozen), then an MLP
-    of ``hidden`` widths to one value."""
+    """The value network: the actor's observation normalisation (a copy, frozen) on the
+    flight's observation, then the ``extra`` columns that follow it (the episode's clock, in
+    [0, 1]) mapped to [-1, 1], then an MLP of ``hidden`` widths to one value."""
 
-    def __init__(self, obs_norm: Normalizer, hidden: list[int]) -> None:
+    def __init__(self, obs_norm: Normalizer, hidden: list[int], extra: int = 0) -> None:
         super().__init__()
         self.obs_norm = copy.deepcopy(obs_norm)
+        self.n_obs = int(self.obs_norm.mean.numel())
         layers: list[nn.Module] = []
-        width = int(self.obs_norm.mean.numel())
+        width = self.n_obs + extra
         for h in hidden:
             layers += [nn.Linear(width, h), nn.Tanh()]
             width = h
@@ -69,7 +74,8 @@ class Critic(nn.Module):
         self.net = nn.Sequential(*layers)
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        out: torch.Tensor = self.net(self.obs_norm(obs))
+        flight, extra = obs[..., : self.n_obs], obs[..., self.n_obs :]
+        out: torch.Tensor = self.net(torch.cat([self.obs_norm(flight), 2 * extra - 1], -1))
         return out
 
 
@@ -123,20 +129,22 @@ class AnchoredPolicy(ActorCriticPolicy):
         start = self._given[0]
         # stable-baselines3 types these slots as its own MLP and Linear layers; any module
         # with their interface fills them
-        self.mlp_extractor = _Pass(self.features_dim)  # type: ignore[assignment]
+        n_obs = start.n_obs
+        extra = self.features_dim - n_obs  # the clock's column, or none
+        assert extra >= 0, (self.features_dim, n_obs)
+        self.mlp_extractor = _Pass(self.features_dim, n_obs)  # type: ignore[assignment]
         self.action_net = copy.deepcopy(start)
         self.action_net.train()
         if isinstance(self.action_dist, StateDependentNoiseDistribution):
             # gSDE: the noise is a linear map of the normalised observation, drawn anew every
             # sde_sample_freq steps, so exploring moves the controls coherently for a while
             # (a white noise on the elevator at 10 Hz averages out before the altitude moves)
-            n_obs = start.n_obs
             _, self.log_std = self.action_dist.proba_distribution_net(
                 latent_dim=n_obs, latent_sde_dim=n_obs, log_std_init=self.log_std_init
             )
         else:
             self.log_std = nn.Parameter(torch.full((start.n_act,), float(self.log_std_init)))
-        self.value_net = Critic(start.obs_norm, self._critic_hidden)  # type: ignore[assignment]
+        self.value_net = Critic(start.obs_norm, self._critic_hidden, extra)  # type: ignore[assignment]
         # the start, frozen: a submodule, so it moves to the policy's device, and kept out
         # of the optimiser's groups
         self.anchor_net = copy.deepcopy(start).eval()
@@ -179,7 +187,7 @@ class AnchoredPolicy(ActorCriticPolicy):
         self, obs: torch.Tensor | dict[str, torch.Tensor], actions: torch.Tensor
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor | None]:
         assert isinstance(obs, torch.Tensor)  # a flight's observation is one vector
-        self._batch = obs  # the minibatch the anchor is computed on
+        self._batch = obs[..., : self.actor.n_obs]  # the minibatch the anchor is computed on
         return super().evaluate_actions(obs, actions)
 
     def anchor_loss(self) -> torch.Tensor | None:

@@ -18,7 +18,6 @@ from __future__ import annotations
 import json
 import logging
 import math
-import os
 import shutil
 import tempfile
 import time
@@ -38,7 +37,7 @@ from gymfg_il.rl.env import make_env
 from gymfg_il.rl.judge import EvalPoint, Judge, plot_curve
 from gymfg_il.rl.policy import AnchoredPolicy
 from gymfg_il.rl.start import Start, as_ppo, meta_of, starting_policy, stats_of
-from gymfg_il.rl.vec import GroupedVecEnv
+from gymfg_il.rl.vec import training_envs
 
 log = logging.getLogger(__name__)
 
@@ -77,7 +76,7 @@ def _train(
     on_eval: Callable[[EvalPoint], None] | None,
     start: Start,
 ) -> PPOResult:
-    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+    from stable_baselines3.common.vec_env import VecNormalize
 
     from gymfg_il.learning.config import resolve_device
     from gymfg_il.policies.checkpoint_folder import check_out
@@ -101,10 +100,9 @@ def _train(
             action["mean"].tolist(),
             action["std"].tolist(),
             cfg.success_bonus,
+            cfg.clock,
         )
-        n = cfg.n_envs
-        cores = len(os.sched_getaffinity(0))
-        venv: Any = GroupedVecEnv([env_fn] * n, cores) if n > 1 else DummyVecEnv([env_fn])
+        venv: Any = training_envs(env_fn, cfg.n_envs)
         venv.seed(cfg.seed)  # env k's first reset takes seed + k
         # rewards scaled by the running spread of the discounted return, never clipped (the
         # success bonus comes as one large reward)

@@ -257,3 +257,41 @@ def test_the_success_bonus_follows_the_verdict_eval_gives(bc_policy):
             assert sum(rewards) == pytest.approx(episode["total_return"] + bonus, abs=1e-6)
             outcomes.add(episode["success"])
     assert outcomes == {True, False}  # both ways were checked
+
+
+def test_the_clock_is_the_critics_and_the_time_limit_ends_the_return(bc_policy, tmp_path):
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from gymfg_il.policies.agent import PolicyAgent
+    from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.run import make_model
+    from gymfg_il.rl.start import starting_policy, stats_of
+
+    cfg = _short(bc_policy, tmp_path / "ppo", clock=True)
+    start = starting_policy(cfg)
+    action = stats_of(start.module, "action_norm")
+    spec = start.flight.to_dict()  # 30-s episodes at 10 Hz: 300 steps
+    env = make_env(spec, action["mean"], action["std"], 0.2, clock=True)
+    obs, _ = env.reset(seed=5)
+    n = start.module.n_obs
+    assert obs.shape == (n + 1,) and obs[-1] == 0.0
+    clocks, ends = [], []
+    for _ in range(300):
+        obs, _, terminated, truncated, _ = env.step(np.zeros(4, dtype=np.float32))
+        clocks.append(obs[-1])
+        ends.append((terminated, truncated))
+    assert clocks[149] == pytest.approx(0.5) and clocks[-1] == 1.0
+    # the limit is the task's end, not a cut to bootstrap past (no crash at neutral controls)
+    assert ends[-1] == (True, False) and not any(any(e) for e in ends[:-1])
+    venv = DummyVecEnv([lambda: env])
+    model = make_model(cfg, venv, start.module, tmp_path / "tb", "cpu", start.flight.agent_hz)
+    bc = PolicyAgent.load(bc_policy)
+    flown, _ = env.reset(seed=6)
+    batch = torch.as_tensor(np.vstack([flown, flown]), dtype=torch.float32)
+    batch[1, -1] = 1.0  # the same state at the time limit
+    now, then = (model.policy.get_distribution(b).distribution.mean for b in batch[:, None])
+    assert torch.equal(now, then)  # the actor never sees the clock
+    assert torch.equal(now, bc.policy(batch[:1, :n]))  # and starts as the clone
+    values = model.policy.predict_values(batch)
+    assert values[0].item() != values[1].item()  # the critic does
+    venv.close()
