@@ -39,8 +39,9 @@ class PPORunConfig:
         envs: environments sampled in parallel, in one process per CPU core (0: four per
             core; ``benchmarks.rl`` measures the sampling rate).
         seed: seeds the envs (env k starts from seed + k), the sampling and the networks; a
-            run with the same settings and the same number of envs repeats exactly (give
-            --envs to repeat a run on a machine with other cores).
+            run with the same settings and the same number of envs repeats exactly on the
+            same machine and install (give --envs to repeat a run on a machine with other
+            cores; on another machine a long run may part from it, docs/results/rl.md).
         eval_every: evaluate the policy's mean action every this many env steps.
         eval_episodes: held-out episodes each evaluation flies (seeds eval_seed, eval_seed +
             1, ...), the same every time, with the controller on them once.
@@ -72,6 +73,13 @@ class PPORunConfig:
         sde_every: steps between new gSDE noise maps (0: one per rollout).
         action_std: the exploration noise's starting spread in the policy's normalised action
             units (1 = the demonstrations' spread of each control).
+        action_floor: the least spread of each control (aileron, elevator, rudder, throttle;
+            raw units) in the units PPO explores and steps the actor in, which are the
+            demonstrations' spread of each control (``--action-std``): a control the
+            demonstrations hardly moved (the throttle in still air) is otherwise explored
+            and changed by that little. The starting policy flies as before (its last layer
+            is rescaled to match); default: the demonstrations' spread as it is (a throttle
+            floor of 0.3 did not raise held-out success in 1M-step runs, docs/results/rl.md).
         critic_warmup: env steps over which only the critic learns, the actor held, so the
             first actor updates follow a trained value function: every update on a rollout
             that began before this many steps (default: a tenth of the run, at most 20,000
@@ -121,6 +129,7 @@ class PPORunConfig:
     exploration: Literal["sde", "gaussian"] = "sde"
     sde_every: int = 0
     action_std: float = 0.2
+    action_floor: tuple[float, float, float, float] | None = None
     critic_warmup: int | None = None
     success_bonus: float = 0.2
     clock: bool = False
@@ -166,6 +175,11 @@ class PPORunConfig:
                 problems.append(f"{name}={value} must be a number >= 0")
         if not (0 < self.action_std <= 10):
             problems.append(f"action_std={self.action_std} must lie in (0, 10]")
+        if self.action_floor is not None and not all(0 <= v <= 1 for v in self.action_floor):
+            problems.append(
+                f"action_floor={self.action_floor}: want four spreads in [0, 1] (raw units of "
+                "aileron, elevator, rudder, throttle)"
+            )
         for name in ("critic_warmup", "anchor_steps"):
             value = getattr(self, name)
             if value is not None and value < 0:

@@ -295,3 +295,19 @@ def test_the_clock_is_the_critics_and_the_time_limit_ends_the_return(bc_policy, 
     values = model.policy.predict_values(batch)
     assert values[0].item() != values[1].item()  # the critic does
     venv.close()
+
+
+def test_an_action_floor_widens_the_units_not_the_flight(bc_policy):
+    from gymfg_il.policies.agent import PolicyAgent
+    from gymfg_il.rl.start import starting_policy
+
+    floor = (0.0, 0.0, 0.0, 0.3)
+    start = starting_policy(PPORunConfig(init=bc_policy, action_floor=floor))
+    bc = PolicyAgent.load(bc_policy).policy
+    std = start.module.action_norm.std
+    assert std[3].item() == pytest.approx(0.3)  # the throttle PPO explores and steps in
+    assert torch.equal(std[:3], bc.action_norm.std[:3])  # the others as the data gave them
+    obs = bc.obs_norm.mean + bc.obs_norm.std * torch.randn(500, bc.n_obs)
+    torch.testing.assert_close(start.module.act(obs)[0], bc.act(obs)[0], atol=1e-5, rtol=0)
+    with pytest.raises(ConfigError, match="action_floor"):
+        PPORunConfig(init=bc_policy, action_floor=(0.0, 0.0, 0.0, 2.0))
