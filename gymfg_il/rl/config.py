@@ -78,8 +78,8 @@ class PPORunConfig:
             demonstrations' spread of each control (``--action-std``): a control the
             demonstrations hardly moved (the throttle in still air) is otherwise explored
             and changed by that little. The starting policy flies as before (its last layer
-            is rescaled to match); default: the demonstrations' spread as it is (a throttle
-            floor of 0.3 did not raise held-out success in 1M-step runs, docs/results/rl.md).
+            is rescaled to match); default: the demonstrations' spread as it is (why:
+            docs/results/rl.md).
         critic_warmup: env steps over which only the critic learns, the actor held, so the
             first actor updates follow a trained value function: every update on a rollout
             that began before this many steps (default: a tenth of the run, at most 20,000
@@ -92,7 +92,7 @@ class PPORunConfig:
             episode's return instead of being bootstrapped past: the task is judged over its
             last seconds and the bonus comes at the limit, so what a state is worth depends
             on the time left (``rl.env.EpisodeClock``). The actor never sees it. Off by
-            default: in 1M-step runs it did not raise held-out success (docs/results/rl.md).
+            default (why: docs/results/rl.md).
         anchor: weight, at the start, of the squared distance between the actor's mean action
             and the starting policy's (normalised units) added to PPO's loss; it decays
             linearly to 0 over anchor_steps (0: no anchor). Not used from scratch.
