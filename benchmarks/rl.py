@@ -1,5 +1,6 @@
 """RL sampling (``train ppo``): stable-baselines3's PPO collecting rollouts (policy inference
-included) from N envs in one process per core (``rl.vec``, as ``train ppo`` runs them),
+included) from N envs in one process per core, each sampling its envs' actions itself
+(``rl.vec``, as ``train ppo`` runs them, torch on one thread),
 against the physics it cannot beat: min(N, cores) bare JSBSim loops doing the same agent
 steps (c172p altitude, 10 Hz = 12 JSBSim frames).
 
@@ -64,7 +65,11 @@ def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> Row:
     min(n_envs, cores): the bound with every core on physics)."""
     import statistics
 
+    import torch
+
     cores = len(os.sched_getaffinity(0))
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)  # as train ppo runs it
     collect, close = sampler(n_envs)
     raw = raw_loop()
     collect(steps // 4)  # the workers warm
@@ -84,6 +89,7 @@ def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> Row:
             ratios.append(rates[collect] / bound)
     finally:
         close()
+        torch.set_num_threads(threads)
     own = n_envs == cores  # the row by its name: as many envs as cores
     return Row(
         "rl_sampling_vs_physics_bound" + ("" if own else f"_{n_envs}_envs"),

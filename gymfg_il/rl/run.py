@@ -37,7 +37,7 @@ from gymfg_il.rl.env import make_env
 from gymfg_il.rl.judge import EvalPoint, Judge, plot_curve
 from gymfg_il.rl.policy import AnchoredPolicy
 from gymfg_il.rl.start import Start, as_ppo, meta_of, starting_policy, stats_of
-from gymfg_il.rl.vec import training_envs
+from gymfg_il.rl.vec import GroupedVecEnv, training_envs
 
 log = logging.getLogger(__name__)
 
@@ -146,7 +146,8 @@ class FineTunePPO(PPO):
     env steps (Adam's first steps, with no history of the gradient, move every weight by
     about the full rate: a cloned network is knocked off its solution), and setting the
     anchor's weight before every update: ``anchor``, decaying linearly to 0 over ``span``
-    env steps after the warm-up."""
+    env steps after the warm-up. On grouped envs its rollouts are sampled in the env
+    processes (``collect_rollouts``)."""
 
     warmup, ramp, anchor, span, actor_scale = 0, 0, 0.0, 0, 1.0
 
@@ -166,6 +167,63 @@ class FineTunePPO(PPO):
         rate = self.lr_schedule(self._current_progress_remaining)
         self.logger.record("train/actor_lr", rate * self.actor_scale * share)
         super().train()
+
+    def collect_rollouts(
+        self, env: Any, callback: Any, rollout_buffer: Any, n_rollout_steps: int
+    ) -> bool:
+        """stable-baselines3's rollout, sampled in the env processes when the envs are
+        grouped (``GroupedVecEnv.rollout``): the same steps, rewards normalised, values
+        bootstrapped, callbacks called and episodes logged step by step as its own
+        ``collect_rollouts`` does, from the arrays the processes return."""
+        import gymnasium as gym
+        from stable_baselines3.common.vec_env import VecNormalize
+
+        norm = env if isinstance(env, VecNormalize) else None
+        grouped = norm.venv if norm is not None else env
+        if not isinstance(grouped, GroupedVecEnv) or not isinstance(
+            self.action_space, gym.spaces.Box
+        ):
+            return bool(super().collect_rollouts(env, callback, rollout_buffer, n_rollout_steps))
+        assert self._last_episode_starts is not None
+        self.policy.set_training_mode(False)
+        rollout_buffer.reset()
+        callback.on_rollout_start()
+        got = grouped.rollout(self.policy, n_rollout_steps, self.seed or 0, self.sde_sample_freq)
+        ends: dict[int, list[tuple[int, dict[str, Any]]]] = {}
+        for t, i, info in got["ends"]:
+            ends.setdefault(t, []).append((i, info))
+        for t in range(n_rollout_steps):
+            rewards, dones = got["rewards"][t], got["dones"][t]
+            if norm is not None:
+                if norm.training:
+                    norm._update_reward(rewards)
+                rewards = norm.normalize_reward(rewards)
+                norm.returns[dones] = 0
+            rewards = rewards + self.gamma * got["bootstrap"][t]
+            infos: list[dict[str, Any]] = [{} for _ in range(env.num_envs)]
+            for i, info in ends.get(t, []):
+                infos[i] = info
+            self.num_timesteps += env.num_envs
+            callback.update_locals({"infos": infos, "dones": dones, "rewards": rewards})
+            if not callback.on_step():
+                return False
+            self._update_info_buffer(infos, dones)
+            rollout_buffer.add(
+                got["obs"][t],
+                got["actions"][t],
+                rewards,
+                self._last_episode_starts,
+                torch.as_tensor(got["values"][t]),
+                torch.as_tensor(got["log_probs"][t]),
+            )
+            self._last_episode_starts = dones
+        self._last_obs = got["last_obs"]
+        rollout_buffer.compute_returns_and_advantage(
+            last_values=torch.as_tensor(got["last_values"]), dones=dones
+        )
+        callback.update_locals({"infos": infos, "dones": dones, "rewards": rewards})
+        callback.on_rollout_end()
+        return True
 
 
 def make_model(
