@@ -12,11 +12,8 @@ seed s + k, a finished episode's last observation goes to ``info["terminal_obser
 the env resets at once, ``info["TimeLimit.truncated"]`` marks a time limit; so a run on it
 repeats a run on ``SubprocVecEnv`` step for step.
 
-Stepping in lockstep still leaves every core idle while the trainer's process runs the policy,
-and costs a pipe round trip a step. ``GroupedVecEnv.rollout`` instead sends each process a copy
-of the policy and its weights once per rollout: each process samples its envs' actions itself,
-as stable-baselines3's ``collect_rollouts`` does, for the whole rollout, and returns the arrays
-its buffer needs (``rl.run.FineTunePPO`` fills the buffer from them).
+``GroupedVecEnv.rollout`` has each process sample its envs' actions itself for a whole
+rollout (``rl.sampling``).
 """
 
 from __future__ import annotations
@@ -38,18 +35,7 @@ from stable_baselines3.common.vec_env.base_vec_env import (
     VecEnvStepReturn,
 )
 
-
-def _step(env: gym.Env, action: np.ndarray) -> tuple[Any, float, bool, dict[str, Any], Any]:
-    """One env's step as stable-baselines3's vector envs give it (resetting a finished one;
-    the reset's info, else None)."""
-    obs, reward, terminated, truncated, info = env.step(action)
-    done = terminated or truncated
-    info["TimeLimit.truncated"] = truncated and not terminated
-    reset_info = None
-    if done:
-        info["terminal_observation"] = obs
-        obs, reset_info = env.reset()
-    return obs, float(reward), done, info, reset_info
+from gymfg_il.rl.sampling import install, merge_rollouts, sample_rollout, sampling_copy, step_env
 
 
 class _Group:
@@ -67,7 +53,7 @@ class _Group:
 
         envs = self.envs
         if cmd == "step":
-            out = [_step(env, a) for env, a in zip(envs, data, strict=True)]
+            out = [step_env(env, a) for env, a in zip(envs, data, strict=True)]
             obs, rewards, dones, infos, resets = zip(*out, strict=True)
             self.obs = list(obs)
             return np.stack(obs), np.array(rewards), np.array(dones), infos, resets
@@ -104,78 +90,18 @@ class _Group:
         raise NotImplementedError(f"{cmd!r} is no command of a GroupedVecEnv worker")
 
     def install(self, policy: CloudpickleWrapper, seed: int) -> None:
-        """Keep ``policy`` (a CPU copy) for rollouts, its sampling seeded by ``seed``; one
-        thread, as ``train ppo`` runs torch (the other cores step the other groups)."""
-        import torch
-
-        torch.set_num_threads(1)
-        torch.manual_seed(seed)
-        # the samples are the policy's own: checking each distribution's arguments is time
-        torch.distributions.Distribution.set_default_validate_args(False)
-        self.policy = policy.var
-        self.policy.set_training_mode(False)
+        """Keep ``policy`` (``sampling.sampling_copy``) for rollouts, seeded by ``seed``."""
+        self.policy = install(policy.var, seed)
 
     def rollout(self, weights: dict[str, Any], n_steps: int, sde_every: int) -> dict[str, Any]:
-        """``n_steps`` steps of every env, each action sampled by the installed policy with
-        ``weights``, as stable-baselines3's ``collect_rollouts`` samples and steps them
-        (``GroupedVecEnv.rollout`` gives the arrays)."""
-        import torch
-
-        policy = self.policy
-        if policy is None:
+        """``sampling.sample_rollout`` of this group's envs with the installed policy."""
+        if self.policy is None:
             raise RuntimeError("rollout before a policy was installed")
-        policy.load_state_dict(weights)
-        space = self.envs[0].action_space
-        assert isinstance(space, gym.spaces.Box)
-        n = len(self.envs)
-        obs_seen, actions, rewards, dones, values, log_probs, bootstrap = ([] for _ in range(7))
-        ends: list[tuple[int, int, dict[str, Any]]] = []  # (step, env, info) of each episode end
-        resets: list[tuple[int, Any]] = []  # (env, info) of each reset, the last one counts
-        if policy.use_sde:
-            policy.reset_noise(n)
-        obs = np.stack(self.obs)
-        with torch.inference_mode():
-            for t in range(n_steps):
-                if policy.use_sde and sde_every > 0 and t % sde_every == 0:
-                    policy.reset_noise(n)
-                action, value, log_prob = policy(torch.as_tensor(obs))
-                action = action.numpy()
-                clipped = np.clip(action, space.low, space.high)
-                out = [_step(env, a) for env, a in zip(self.envs, clipped, strict=True)]
-                obs_seen.append(obs)
-                actions.append(action)
-                values.append(value.numpy().ravel())
-                log_probs.append(log_prob.numpy().ravel())
-                rewards.append(np.array([o[1] for o in out]))
-                dones.append(np.array([o[2] for o in out]))
-                # a time limit's cut: stable-baselines3 adds gamma x the value of where it ended
-                extra = np.zeros(n, dtype=np.float32)
-                cut = [i for i, o in enumerate(out) if o[2] and o[3]["TimeLimit.truncated"]]
-                if cut:
-                    last = np.stack([out[i][3]["terminal_observation"] for i in cut])
-                    extra[cut] = policy.predict_values(torch.as_tensor(last)).numpy().ravel()
-                bootstrap.append(extra)
-                for i, o in enumerate(out):
-                    if o[2]:
-                        ends.append((t, i, o[3]))
-                    if o[4] is not None:
-                        resets.append((i, o[4]))
-                obs = np.stack([o[0] for o in out])
-            last_values = policy.predict_values(torch.as_tensor(obs)).numpy().ravel()
-        self.obs = list(obs)
-        return {
-            "obs": np.stack(obs_seen),
-            "actions": np.stack(actions),
-            "rewards": np.stack(rewards),
-            "dones": np.stack(dones),
-            "values": np.stack(values),
-            "log_probs": np.stack(log_probs),
-            "bootstrap": np.stack(bootstrap),
-            "last_obs": obs,
-            "last_values": last_values,
-            "ends": ends,
-            "resets": resets,
-        }
+        out = sample_rollout(
+            self.policy, self.envs, np.stack(self.obs), weights, n_steps, sde_every
+        )
+        self.obs = list(out["last_obs"])
+        return out
 
 
 def _worker(remote: Any, parent: Any, fns: CloudpickleWrapper) -> None:
@@ -213,31 +139,6 @@ def groups_of(n_envs: int, processes: int) -> list[range]:
     for g in range(k):
         bounds.append(bounds[-1] + size + (g < extra))
     return [range(a, b) for a, b in itertools.pairwise(bounds)]
-
-
-def sampling_copy(policy: Any) -> Any:
-    """A CPU copy of a stable-baselines3 actor-critic to sample rollouts with: without its
-    optimiser (not needed, and large) or what its last forward pass left behind (the
-    distribution's tensors, which are not graph leaves and cannot be copied)."""
-    import copy
-
-    import torch
-
-    def transient(value: Any) -> bool:
-        return isinstance(value, torch.Tensor | torch.distributions.Distribution)
-
-    dist = policy.action_dist
-    kept_dist = {k: v for k, v in vars(dist).items() if transient(v)}
-    kept = {k: v for k, v in vars(policy).items() if transient(v) or k == "optimizer"}
-    try:
-        for k in kept_dist:
-            setattr(dist, k, None)
-        for k in kept:
-            setattr(policy, k, None)
-        return copy.deepcopy(policy).to("cpu")
-    finally:
-        vars(dist).update(kept_dist)
-        vars(policy).update(kept)
 
 
 class GroupedVecEnv(VecEnv):
@@ -341,24 +242,9 @@ class GroupedVecEnv(VecEnv):
         weights = {k: v.detach().cpu() for k, v in policy.state_dict().items()}
         for remote in self.remotes:
             remote.send(("rollout", (weights, n_steps, sde_every)))
-        parts = self._recv_all(self.remotes)
-        out: dict[str, Any] = {
-            key: np.concatenate([p[key] for p in parts], axis=1)
-            for key in ("obs", "actions", "rewards", "dones", "values", "log_probs", "bootstrap")
-        }
-        for key in ("last_obs", "last_values"):
-            out[key] = np.concatenate([p[key] for p in parts])
-        out["ends"] = sorted(
-            (
-                (t, group.start + i, info)
-                for p, group in zip(parts, self.groups, strict=True)
-                for t, i, info in p["ends"]
-            ),
-            key=lambda end: end[:2],
-        )
-        for p, group in zip(parts, self.groups, strict=True):
-            for i, info in p["resets"]:
-                self.reset_infos[group.start + i] = info
+        out = merge_rollouts(self._recv_all(self.remotes), self.groups)
+        for i, info in out.pop("resets"):
+            self.reset_infos[i] = info
         return out
 
     def close(self) -> None:

@@ -1,0 +1,149 @@
+"""Rollouts sampled in the env processes (``GroupedVecEnv.rollout``): each process holds a
+CPU copy of the policy, receives its weights once per rollout, and samples and steps its own
+envs as stable-baselines3's ``collect_rollouts`` does, for the whole rollout; the trainer's
+process fills stable-baselines3's buffer from the arrays (``rl.run.FineTunePPO``).
+
+Stepping in lockstep with the trainer leaves every core idle while the trainer's process runs
+the policy, and costs a pipe round trip every step (docs/results/rl.md, Speed).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+
+def step_env(env: gym.Env, action: np.ndarray) -> tuple[Any, float, bool, dict[str, Any], Any]:
+    """One env's step as stable-baselines3's vector envs give it (resetting a finished one;
+    the reset's info, else None)."""
+    obs, reward, terminated, truncated, info = env.step(action)
+    done = terminated or truncated
+    info["TimeLimit.truncated"] = truncated and not terminated
+    reset_info = None
+    if done:
+        info["terminal_observation"] = obs
+        obs, reset_info = env.reset()
+    return obs, float(reward), done, info, reset_info
+
+
+def sampling_copy(policy: Any) -> Any:
+    """A CPU copy of a stable-baselines3 actor-critic to sample rollouts with: without its
+    optimiser (not needed, and large) or what its last forward pass left behind (the
+    distribution's tensors, which are not graph leaves and cannot be copied)."""
+    import copy
+
+    import torch
+
+    def transient(value: Any) -> bool:
+        return isinstance(value, torch.Tensor | torch.distributions.Distribution)
+
+    dist = policy.action_dist
+    kept_dist = {k: v for k, v in vars(dist).items() if transient(v)}
+    kept = {k: v for k, v in vars(policy).items() if transient(v) or k == "optimizer"}
+    try:
+        for k in kept_dist:
+            setattr(dist, k, None)
+        for k in kept:
+            setattr(policy, k, None)
+        return copy.deepcopy(policy).to("cpu")
+    finally:
+        vars(dist).update(kept_dist)
+        vars(policy).update(kept)
+
+
+def install(policy: Any, seed: int) -> Any:
+    """``policy`` (a ``sampling_copy``) made ready to sample in an env process, its samples
+    seeded by ``seed``; torch on one thread, as ``train ppo`` runs it (the other cores step
+    the other processes' envs)."""
+    import torch
+
+    torch.set_num_threads(1)
+    torch.manual_seed(seed)
+    # the samples are the policy's own: checking each distribution's arguments is time
+    torch.distributions.Distribution.set_default_validate_args(False)
+    policy.set_training_mode(False)
+    return policy
+
+
+def sample_rollout(
+    policy: Any,
+    envs: list[gym.Env],
+    obs: np.ndarray,
+    weights: dict[str, Any],
+    n_steps: int,
+    sde_every: int,
+) -> dict[str, Any]:
+    """``n_steps`` steps of ``envs`` from their observations ``obs``, each action sampled by
+    ``policy`` with ``weights``, as stable-baselines3's ``collect_rollouts`` samples and steps
+    them (the keys: ``GroupedVecEnv.rollout``; ``resets``, (env, info) of every reset)."""
+    import torch
+
+    policy.load_state_dict(weights)
+    space = envs[0].action_space
+    assert isinstance(space, gym.spaces.Box)
+    n = len(envs)
+    obs_seen, actions, rewards, dones, values, log_probs, bootstrap = ([] for _ in range(7))
+    ends: list[tuple[int, int, dict[str, Any]]] = []  # (step, env, info) of each episode end
+    resets: list[tuple[int, Any]] = []  # (env, info) of each reset, the last one counts
+    if policy.use_sde:
+        policy.reset_noise(n)
+    with torch.inference_mode():
+        for t in range(n_steps):
+            if policy.use_sde and sde_every > 0 and t % sde_every == 0:
+                policy.reset_noise(n)
+            action, value, log_prob = policy(torch.as_tensor(obs))
+            action = action.numpy()
+            clipped = np.clip(action, space.low, space.high)
+            out = [step_env(env, a) for env, a in zip(envs, clipped, strict=True)]
+            obs_seen.append(obs)
+            actions.append(action)
+            values.append(value.numpy().ravel())
+            log_probs.append(log_prob.numpy().ravel())
+            rewards.append(np.array([o[1] for o in out]))
+            dones.append(np.array([o[2] for o in out]))
+            # a time limit's cut: stable-baselines3 adds gamma x the value of where it ended
+            extra = np.zeros(n, dtype=np.float32)
+            cut = [i for i, o in enumerate(out) if o[2] and o[3]["TimeLimit.truncated"]]
+            if cut:
+                last = np.stack([out[i][3]["terminal_observation"] for i in cut])
+                extra[cut] = policy.predict_values(torch.as_tensor(last)).numpy().ravel()
+            bootstrap.append(extra)
+            for i, o in enumerate(out):
+                if o[2]:
+                    ends.append((t, i, o[3]))
+                if o[4] is not None:
+                    resets.append((i, o[4]))
+            obs = np.stack([o[0] for o in out])
+        last_values = policy.predict_values(torch.as_tensor(obs)).numpy().ravel()
+    return {
+        "obs": np.stack(obs_seen),
+        "actions": np.stack(actions),
+        "rewards": np.stack(rewards),
+        "dones": np.stack(dones),
+        "values": np.stack(values),
+        "log_probs": np.stack(log_probs),
+        "bootstrap": np.stack(bootstrap),
+        "last_obs": obs,
+        "last_values": last_values,
+        "ends": ends,
+        "resets": resets,
+    }
+
+
+def merge_rollouts(parts: list[dict[str, Any]], groups: list[range]) -> dict[str, Any]:
+    """The env processes' rollouts (``parts``, of the envs in ``groups``) as one, in env order."""
+    out: dict[str, Any] = {
+        key: np.concatenate([p[key] for p in parts], axis=1)
+        for key in ("obs", "actions", "rewards", "dones", "values", "log_probs", "bootstrap")
+    }
+    for key in ("last_obs", "last_values"):
+        out[key] = np.concatenate([p[key] for p in parts])
+    paired = list(zip(parts, groups, strict=True))
+    out["ends"] = sorted(
+        ((t, group.start + i, info) for p, group in paired for t, i, info in p["ends"]),
+        key=lambda end: end[:2],
+    )
+    out["resets"] = [(group.start + i, info) for p, group in paired for i, info in p["resets"]]
+    return out
