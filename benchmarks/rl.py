@@ -1,6 +1,6 @@
 """RL sampling (``train ppo``): stable-baselines3's PPO collecting rollouts (policy inference
 included) from N envs in one process per core, each sampling its envs' actions itself
-(``rl.vec``, as ``train ppo`` runs them, torch on one thread),
+(``rl.vec``, as ``train ppo`` runs them, the policy as numpy functions: ``rl.forward``),
 against the physics it cannot beat: min(N, cores) bare JSBSim loops doing the same agent
 steps (c172p altitude, 10 Hz = 12 JSBSim frames).
 

@@ -1,7 +1,8 @@
 """Rollouts sampled in the env processes (``GroupedVecEnv.rollout``): each process holds a
-CPU copy of the policy, receives its weights once per rollout, and samples and steps its own
-envs as stable-baselines3's ``collect_rollouts`` does, for the whole rollout; the trainer's
-process fills stable-baselines3's buffer from the arrays (``rl.run.FineTunePPO``).
+CPU copy of the policy, run as numpy functions (``rl.forward``), receives its weights once per
+rollout, and samples and steps its own envs as stable-baselines3's ``collect_rollouts`` does,
+for the whole rollout; the trainer's process fills stable-baselines3's buffer from the arrays
+(``rl.run.FineTunePPO``).
 
 Stepping in lockstep with the trainer leaves every core idle while the trainer's process runs
 the policy, and costs a pipe round trip every step (docs/results/rl.md, Speed).
@@ -13,6 +14,8 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+
+from gymfg_il.rl.forward import NumpyActorCritic
 
 
 def step_env(env: gym.Env, action: np.ndarray) -> tuple[Any, float, bool, dict[str, Any], Any]:
@@ -53,22 +56,21 @@ def sampling_copy(policy: Any) -> Any:
         vars(policy).update(kept)
 
 
-def install(policy: Any, seed: int) -> Any:
-    """``policy`` (a ``sampling_copy``) made ready to sample in an env process, its samples
-    seeded by ``seed``; torch on one thread, as ``train ppo`` runs it (the other cores step
-    the other processes' envs)."""
+def install(policy: Any, seed: int) -> NumpyActorCritic:
+    """``policy`` (a ``sampling_copy``) made ready to sample in an env process: as numpy
+    functions (``rl.forward``), its samples seeded by ``seed``, BLAS and torch on one thread
+    (the other cores step the other processes' envs)."""
     import torch
+    from threadpoolctl import threadpool_limits
 
     torch.set_num_threads(1)
-    torch.manual_seed(seed)
-    # the samples are the policy's own: checking each distribution's arguments is time
-    torch.distributions.Distribution.set_default_validate_args(False)
+    threadpool_limits(1)
     policy.set_training_mode(False)
-    return policy
+    return NumpyActorCritic(policy, np.random.default_rng(seed))
 
 
 def sample_rollout(
-    policy: Any,
+    policy: NumpyActorCritic,
     envs: list[gym.Env],
     obs: np.ndarray,
     weights: dict[str, Any],
@@ -78,45 +80,39 @@ def sample_rollout(
     """``n_steps`` steps of ``envs`` from their observations ``obs``, each action sampled by
     ``policy`` with ``weights``, as stable-baselines3's ``collect_rollouts`` samples and steps
     them (the keys: ``GroupedVecEnv.rollout``; ``resets``, (env, info) of every reset)."""
-    import torch
-
-    policy.load_state_dict(weights)
+    policy.load(weights)
     space = envs[0].action_space
     assert isinstance(space, gym.spaces.Box)
     n = len(envs)
     obs_seen, actions, rewards, dones, values, log_probs, bootstrap = ([] for _ in range(7))
     ends: list[tuple[int, int, dict[str, Any]]] = []  # (step, env, info) of each episode end
     resets: list[tuple[int, Any]] = []  # (env, info) of each reset, the last one counts
-    if policy.use_sde:
-        policy.reset_noise(n)
-    with torch.inference_mode():
-        for t in range(n_steps):
-            if policy.use_sde and sde_every > 0 and t % sde_every == 0:
-                policy.reset_noise(n)
-            action, value, log_prob = policy(torch.as_tensor(obs))
-            action = action.numpy()
-            clipped = np.clip(action, space.low, space.high)
-            out = [step_env(env, a) for env, a in zip(envs, clipped, strict=True)]
-            obs_seen.append(obs)
-            actions.append(action)
-            values.append(value.numpy().ravel())
-            log_probs.append(log_prob.numpy().ravel())
-            rewards.append(np.array([o[1] for o in out]))
-            dones.append(np.array([o[2] for o in out]))
-            # a time limit's cut: stable-baselines3 adds gamma x the value of where it ended
-            extra = np.zeros(n, dtype=np.float32)
-            cut = [i for i, o in enumerate(out) if o[2] and o[3]["TimeLimit.truncated"]]
-            if cut:
-                last = np.stack([out[i][3]["terminal_observation"] for i in cut])
-                extra[cut] = policy.predict_values(torch.as_tensor(last)).numpy().ravel()
-            bootstrap.append(extra)
-            for i, o in enumerate(out):
-                if o[2]:
-                    ends.append((t, i, o[3]))
-                if o[4] is not None:
-                    resets.append((i, o[4]))
-            obs = np.stack([o[0] for o in out])
-        last_values = policy.predict_values(torch.as_tensor(obs)).numpy().ravel()
+    policy.reset_noise(n)
+    for t in range(n_steps):
+        if sde_every > 0 and t % sde_every == 0:
+            policy.reset_noise(n)
+        action, value, log_prob = policy(obs)
+        clipped = np.clip(action, space.low, space.high)
+        out = [step_env(env, a) for env, a in zip(envs, clipped, strict=True)]
+        obs_seen.append(obs)
+        actions.append(action)
+        values.append(value)
+        log_probs.append(log_prob)
+        rewards.append(np.array([o[1] for o in out]))
+        dones.append(np.array([o[2] for o in out]))
+        # a time limit's cut: stable-baselines3 adds gamma x the value of where it ended
+        extra = np.zeros(n, dtype=np.float32)
+        cut = [i for i, o in enumerate(out) if o[2] and o[3]["TimeLimit.truncated"]]
+        if cut:
+            extra[cut] = policy.values(np.stack([out[i][3]["terminal_observation"] for i in cut]))
+        bootstrap.append(extra)
+        for i, o in enumerate(out):
+            if o[2]:
+                ends.append((t, i, o[3]))
+            if o[4] is not None:
+                resets.append((i, o[4]))
+        obs = np.stack([o[0] for o in out])
+    last_values = policy.values(obs)
     return {
         "obs": np.stack(obs_seen),
         "actions": np.stack(actions),

@@ -1,0 +1,135 @@
+"""The actor-critic's sampling pass in numpy, for the env processes (``rl.sampling``).
+
+On the few observations one env process samples at a time, torch spends a step mostly in its
+per-operation overhead and stable-baselines3's distribution classes (300-375 µs for 4 envs,
+about the 4 envs' physics; docs/results/rl.md, Speed). ``NumpyActorCritic`` does the same
+arithmetic as ``AnchoredPolicy.forward`` on numpy arrays, from the policy's current weights:
+the actor's mean, stable-baselines3's gSDE noise (or its diagonal Gaussian's), the
+log-probability of the sampled action and the critic's value, in float32 as torch computes
+them. ``tests/rl/test_forward.py`` holds it to the torch policy's ``evaluate_actions``.
+
+BLAS runs on one thread in the process that installs it: with several env processes on the
+cores, a threaded matrix product waits on cores that are stepping other envs.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+Layer = Callable[[np.ndarray], np.ndarray]
+
+_LOG_SQRT_2PI = 0.5 * math.log(2 * math.pi)
+# erf within 1.5e-7 (Abramowitz and Stegun, 7.1.26): numpy has no erf, and nn.GELU's exact
+# form is x * (1 + erf(x / sqrt 2)) / 2
+_P, _A = 0.3275911, (1.061405429, -1.453152027, 1.421413741, -0.284496736, 0.254829592)
+
+
+def erf(x: np.ndarray) -> np.ndarray:
+    """The error function, elementwise, within 1.5e-7."""
+    t = 1.0 / (1.0 + _P * np.abs(x))
+    poly = _A[0]
+    for a in _A[1:]:
+        poly = poly * t + a
+    return np.copysign(1.0 - poly * t * np.exp(-x * x), x)
+
+
+def _gelu(approximate: str) -> Layer:
+    if approximate == "tanh":
+        c = math.sqrt(2 / math.pi)
+        return lambda x: 0.5 * x * (1.0 + np.tanh(c * (x + 0.044715 * x * x * x)))
+    return lambda x: 0.5 * x * (1.0 + erf(x * (1 / math.sqrt(2))))
+
+
+def _linear(w: np.ndarray, b: np.ndarray) -> Layer:
+    return lambda x: x @ w + b
+
+
+def layers(net: Any) -> list[Layer]:
+    """``net`` (a torch ``nn.Sequential`` of Linear, GELU, Tanh and Dropout layers) as numpy
+    functions of a batch, dropout left out (it is off while sampling)."""
+    from torch import nn
+
+    out: list[Layer] = []
+    for m in net:
+        if isinstance(m, nn.Linear):
+            out.append(_linear(m.weight.detach().numpy().T.copy(), m.bias.detach().numpy().copy()))
+        elif isinstance(m, nn.GELU):
+            out.append(_gelu(m.approximate))
+        elif isinstance(m, nn.Tanh):
+            out.append(np.tanh)
+        elif not isinstance(m, nn.Dropout):
+            raise TypeError(f"no numpy pass for the layer {m!r}")
+    return out
+
+
+def _run(net: list[Layer], x: np.ndarray) -> np.ndarray:
+    for layer in net:
+        x = layer(x)
+    return x
+
+
+class NumpyActorCritic:
+    """``policy`` (an ``rl.policy.AnchoredPolicy``, on the CPU) as numpy functions, its noise
+    drawn from ``rng``. ``load`` takes the policy's weights anew (call it after each update);
+    ``reset_noise(n)`` draws gSDE's noise maps for ``n`` envs, as the policy's own does."""
+
+    def __init__(self, policy: Any, rng: np.random.Generator) -> None:
+        self.policy, self.rng = policy, rng
+        self.use_sde = bool(policy.use_sde)
+        if self.use_sde:
+            dist = policy.action_dist
+            if dist.use_expln or not dist.full_std or dist.bijector is not None:
+                raise ValueError("the numpy pass follows gSDE with full_std and no expln/squash")
+            self.epsilon = float(dist.epsilon)
+        self.noise: np.ndarray | None = None
+        self.load(None)
+
+    def load(self, weights: dict[str, Any] | None) -> None:
+        """Take ``weights`` (the policy's ``state_dict``; None: those it has)."""
+        if weights is not None:
+            self.policy.load_state_dict(weights)
+        actor, critic = self.policy.actor, self.policy.value_net
+
+        def stats(norm: Any) -> tuple[np.ndarray, np.ndarray]:
+            return norm.mean.numpy().copy(), norm.std.numpy().copy()
+
+        self.n_actor, self.n_critic = actor.n_obs, critic.n_obs
+        self.actor_norm, self.critic_norm = stats(actor.obs_norm), stats(critic.obs_norm)
+        self.actor, self.critic = layers(actor.net), layers(critic.net)
+        self.std = np.exp(self.policy.log_std.detach().numpy())  # (n_obs, n_act) with gSDE
+
+    def reset_noise(self, n: int) -> None:
+        """gSDE: a new noise map per env (``n`` of them); without gSDE, nothing."""
+        if self.use_sde:
+            self.noise = (self.rng.standard_normal((n, *self.std.shape)) * self.std).astype(
+                np.float32
+            )
+
+    def values(self, obs: np.ndarray) -> np.ndarray:
+        """The critic's value of each observation (a batch), shape (batch,)."""
+        mean, std = self.critic_norm
+        flight = (obs[:, : self.n_critic] - mean) / std
+        x = np.concatenate([flight, 2 * obs[:, self.n_critic :] - 1], axis=1)
+        return _run(self.critic, x)[:, 0]
+
+    def __call__(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """A sampled action, the value and the action's log-probability for each observation
+        of a float32 batch, as the policy's ``forward`` gives them."""
+        mean, std = self.actor_norm
+        z = (obs[:, : self.n_actor] - mean) / std
+        mu = _run(self.actor, z)
+        if self.use_sde:
+            assert self.noise is not None, "reset_noise before sampling"
+            action = mu + np.matmul(z[:, None, :], self.noise)[:, 0, :]
+            scale = np.sqrt((z * z) @ (self.std * self.std) + self.epsilon)
+        else:
+            scale = np.broadcast_to(self.std, mu.shape)
+            action = mu + self.rng.standard_normal(mu.shape).astype(np.float32) * scale
+        action = action.astype(np.float32)
+        d = (action.astype(np.float64) - mu) / scale
+        log_prob = (-0.5 * d * d - np.log(scale) - _LOG_SQRT_2PI).sum(axis=1)
+        return action, self.values(obs), log_prob.astype(np.float32)
