@@ -3,7 +3,6 @@ mean, value and log-probability, and noise of the policy's own spread."""
 
 from __future__ import annotations
 
-import math
 from functools import partial
 
 import numpy as np
@@ -19,14 +18,9 @@ from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.policies.modeling_mlp import MLPPolicy
 from gymfg_il.rl.config import PPORunConfig
 from gymfg_il.rl.env import make_env
-from gymfg_il.rl.forward import NumpyActorCritic, erf
+from gymfg_il.rl.forward import NumpyActorCritic
 from gymfg_il.rl.run import make_model
 from gymfg_il.rl.sampling import sampling_copy
-
-
-def test_erf_is_within_2e_7():
-    x = np.linspace(-6, 6, 24001)
-    assert np.abs(erf(x) - np.array([math.erf(v) for v in x])).max() < 2e-7
 
 
 def _policy(tmp_path, exploration, clock):
