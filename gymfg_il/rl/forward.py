@@ -4,10 +4,10 @@ On the few observations one env process samples at a time, torch spends a step m
 per-operation overhead and stable-baselines3's distribution classes (300-375 µs for 4 envs,
 about the 4 envs' physics; docs/results/rl.md, Speed). ``NumpyActorCritic`` does the same
 arithmetic as ``AnchoredPolicy.forward`` on numpy arrays (the GELU by torch's own kernel on
-the same memory), from the policy's current weights:
-the actor's mean, stable-baselines3's gSDE noise (or its diagonal Gaussian's), the
-log-probability of the sampled action and the critic's value, in float32 as torch computes
-them. ``tests/rl/test_forward.py`` holds it to the torch policy's ``evaluate_actions``.
+the same memory), from the policy's current weights: the actor's mean, stable-baselines3's
+gSDE noise (or its diagonal Gaussian's), the log-probability of the sampled action and the
+critic's value, in float32 as torch computes them. ``tests/rl/test_forward.py`` holds it to
+the torch policy's ``evaluate_actions``.
 
 BLAS runs on one thread in the process that installs it: with several env processes on the
 cores, a threaded matrix product waits on cores that are stepping other envs.
