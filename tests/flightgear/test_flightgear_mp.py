@@ -98,7 +98,10 @@ class Sky:
     def set(self, prop, value):
         self.fg.set(prop, value)
 
-    def env(self, timeout_s=2.0):
+    def env(self, timeout_s=30.0):
+        """An env hearing the shared fgfs. The default keeps a FlightGear that stalls (a busy
+        machine's fgfs has gone silent for over 2 s mid-flight) in the sky; only the test of
+        dropping a silent FlightGear asks for a short ``timeout_s``."""
         config = MultiplayerConfig(
             listen_port=self.listen, send_to=[("127.0.0.1", self.fg_in)], timeout_s=timeout_s
         )
