@@ -107,20 +107,36 @@ class NumpyActorCritic:
         x = np.concatenate([flight, 2 * obs[:, self.n_critic :] - 1], axis=1)
         return _run(self.critic, x)[:, 0]
 
-    def __call__(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """A sampled action, the value and the action's log-probability for each observation
-        of a float32 batch, as the policy's ``forward`` gives them."""
+    def sample(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A sampled action and the actor's mean for each observation of a float32 batch:
+        all a step needs (``score`` values a whole rollout's steps at once, afterwards)."""
         mean, std = self.actor_norm
         z = (obs[:, : self.n_actor] - mean) / std
         mu = _run(self.actor, z)
         if self.use_sde:
             assert self.noise is not None, "reset_noise before sampling"
             action = mu + np.matmul(z[:, None, :], self.noise)[:, 0, :]
+        else:
+            action = mu + self.rng.standard_normal(mu.shape).astype(np.float32) * self.std
+        return action.astype(np.float32), mu
+
+    def score(
+        self, obs: np.ndarray, actions: np.ndarray, mu: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The critic's value of each observation and the log-probability of each action,
+        ``actions`` and ``mu`` as ``sample`` gave them for ``obs`` with the same weights."""
+        if self.use_sde:
+            mean, std = self.actor_norm
+            z = (obs[:, : self.n_actor] - mean) / std
             scale = np.sqrt((z * z) @ (self.std * self.std) + self.epsilon)
         else:
             scale = np.broadcast_to(self.std, mu.shape)
-            action = mu + self.rng.standard_normal(mu.shape).astype(np.float32) * scale
-        action = action.astype(np.float32)
-        d = (action.astype(np.float64) - mu) / scale
+        d = (actions.astype(np.float64) - mu) / scale
         log_prob = (-0.5 * d * d - np.log(scale) - _LOG_SQRT_2PI).sum(axis=1)
-        return action, self.values(obs), log_prob.astype(np.float32)
+        return self.values(obs), log_prob.astype(np.float32)
+
+    def __call__(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """A sampled action, the value and the action's log-probability for each observation
+        of a float32 batch, as the policy's ``forward`` gives them."""
+        action, mu = self.sample(obs)
+        return action, *self.score(obs, action, mu)

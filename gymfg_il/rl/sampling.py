@@ -84,45 +84,51 @@ def sample_rollout(
     space = envs[0].action_space
     assert isinstance(space, gym.spaces.Box)
     n = len(envs)
-    obs_seen, actions, rewards, dones, values, log_probs, bootstrap = ([] for _ in range(7))
+    obs_seen, actions, means, rewards, dones = ([] for _ in range(5))
     ends: list[tuple[int, int, dict[str, Any]]] = []  # (step, env, info) of each episode end
     resets: list[tuple[int, Any]] = []  # (env, info) of each reset, the last one counts
+    cuts: list[tuple[int, int, np.ndarray]] = []  # (step, env, last obs) of each time limit
     policy.reset_noise(n)
     for t in range(n_steps):
         if sde_every > 0 and t % sde_every == 0:
             policy.reset_noise(n)
-        action, value, log_prob = policy(obs)
+        action, mu = policy.sample(obs)
         clipped = np.clip(action, space.low, space.high)
         out = [step_env(env, a) for env, a in zip(envs, clipped, strict=True)]
         obs_seen.append(obs)
         actions.append(action)
-        values.append(value)
-        log_probs.append(log_prob)
+        means.append(mu)
         rewards.append(np.array([o[1] for o in out]))
         dones.append(np.array([o[2] for o in out]))
-        # a time limit's cut: stable-baselines3 adds gamma x the value of where it ended
-        extra = np.zeros(n, dtype=np.float32)
-        cut = [i for i, o in enumerate(out) if o[2] and o[3]["TimeLimit.truncated"]]
-        if cut:
-            extra[cut] = policy.values(np.stack([out[i][3]["terminal_observation"] for i in cut]))
-        bootstrap.append(extra)
         for i, o in enumerate(out):
             if o[2]:
                 ends.append((t, i, o[3]))
+                if o[3]["TimeLimit.truncated"]:
+                    cuts.append((t, i, o[3]["terminal_observation"]))
             if o[4] is not None:
                 resets.append((i, o[4]))
         obs = np.stack([o[0] for o in out])
-    last_values = policy.values(obs)
+    # values and log-probabilities of the whole rollout in one pass (the weights held still)
+    seen = np.stack(obs_seen)
+    flat = (n_steps * n, -1)
+    values, log_probs = policy.score(
+        seen.reshape(flat), np.stack(actions).reshape(flat), np.stack(means).reshape(flat)
+    )
+    # a time limit's cut: stable-baselines3 adds gamma x the value of where it ended
+    bootstrap = np.zeros((n_steps, n), dtype=np.float32)
+    if cuts:
+        steps, at, last = zip(*cuts, strict=True)
+        bootstrap[list(steps), list(at)] = policy.values(np.stack(last))
     return {
-        "obs": np.stack(obs_seen),
+        "obs": seen,
         "actions": np.stack(actions),
         "rewards": np.stack(rewards),
         "dones": np.stack(dones),
-        "values": np.stack(values),
-        "log_probs": np.stack(log_probs),
-        "bootstrap": np.stack(bootstrap),
+        "values": values.reshape(n_steps, n),
+        "log_probs": log_probs.reshape(n_steps, n),
+        "bootstrap": bootstrap,
         "last_obs": obs,
-        "last_values": last_values,
+        "last_values": policy.values(obs),
         "ends": ends,
         "resets": resets,
     }
