@@ -1,0 +1,77 @@
+"""One env process's share of ``train ppo``'s sampling, in this process: ``N`` c172p altitude
+envs (10 Hz) sampled by the numpy policy (``rl.sampling.sample_rollout``, a fresh MLP), beside
+a bare JSBSim loop of the same agent steps (``benchmarks.physics.raw_loop``), three rounds;
+with ``--profile``, cProfile's top functions of one more rollout.
+
+    PYTHONPATH=. python docs/experiments/rl_sampling_profile.py [--envs 4] [--profile]
+
+The results: docs/results/rl.md, Speed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import pstats
+import tempfile
+import time
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+from benchmarks.physics import raw_loop
+from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.policies.configuration_mlp import MLPConfig
+from gymfg_il.policies.modeling_mlp import MLPPolicy
+from gymfg_il.rl.config import PPORunConfig
+from gymfg_il.rl.env import make_env
+from gymfg_il.rl.run import make_model
+from gymfg_il.rl.sampling import install, sample_rollout, sampling_copy
+
+STEPS = 2000  # steps of each env a round
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--envs", type=int, default=4, help="envs in the process")
+    parser.add_argument("--profile", action="store_true", help="print cProfile's top 30")
+    args = parser.parse_args()
+    flight = FlightSpec.solo("c172p", "altitude")
+    probe = flight.make_env()
+    n_obs = probe.observation_space.shape[0]
+    probe.close()
+    stats = [{"mean": np.zeros(n), "std": np.ones(n)} for n in (n_obs, 4)]
+    env_fn = partial(make_env, flight.to_dict(), [0.0] * 4, [1.0] * 4, 0.2)
+    venv = VecNormalize(DummyVecEnv([env_fn]), norm_obs=False, norm_reward=True)
+    cfg = PPORunConfig(init=Path("unused"), envs=1, rollout_steps=64, batch_size=64)
+    module = MLPPolicy(MLPConfig(), *stats)
+    model = make_model(cfg, venv, module, Path(tempfile.mkdtemp()), "cpu", flight.agent_hz)
+    policy = install(sampling_copy(model.policy), 0)
+    weights = {k: v.detach().cpu() for k, v in model.policy.state_dict().items()}
+    envs = [env_fn() for _ in range(args.envs)]
+    obs = np.stack([env.reset(seed=i)[0] for i, env in enumerate(envs)])
+    sample_rollout(policy, envs, obs, weights, 200, 4)  # warm
+    raw = raw_loop()
+    for r in range(3):
+        start = time.perf_counter()
+        sample_rollout(policy, envs, obs, weights, STEPS, 4)
+        sampled = (time.perf_counter() - start) / (STEPS * args.envs)
+        start = time.perf_counter()
+        raw(STEPS)
+        bare = (time.perf_counter() - start) / STEPS
+        print(
+            f"round {r}: sampling {sampled * 1e6:.1f} µs an env step, bare JSBSim "
+            f"{bare * 1e6:.1f} µs a step, ratio {bare / sampled:.2f}"
+        )
+    if args.profile:
+        profile = cProfile.Profile()
+        profile.enable()
+        sample_rollout(policy, envs, obs, weights, STEPS, 4)
+        profile.disable()
+        pstats.Stats(profile).sort_stats("tottime").print_stats(30)
+
+
+if __name__ == "__main__":
+    main()
