@@ -93,6 +93,10 @@ class PPORunConfig:
             last seconds and the bonus comes at the limit, so what a state is worth depends
             on the time left (``rl.env.EpisodeClock``). The actor never sees it. Off by
             default (why: docs/results/rl.md).
+        stall_margin_kt: each training step flown slower than the aircraft's stall speed
+            (where the task ends an episode) plus this many knots costs a step's whole task
+            reward (1): a stall otherwise costs only the reward after it, a few steps' worth
+            at PPO's discount (0: no cost; docs/results/rl.md).
         anchor: weight, at the start, of the squared distance between the actor's mean action
             and the starting policy's (normalised units) added to PPO's loss; it decays
             linearly to 0 over anchor_steps (0: no anchor). Not used from scratch.
@@ -133,6 +137,7 @@ class PPORunConfig:
     critic_warmup: int | None = None
     success_bonus: float = 0.2
     clock: bool = False
+    stall_margin_kt: float = 0.0
     anchor: float = 1.0
     anchor_steps: int | None = None
     critic: list[int] = field(default_factory=lambda: [256, 256])
@@ -169,7 +174,7 @@ class PPORunConfig:
                 problems.append(f"{name}={value} must lie in (0, 1]")
         if not 0 < self.clip_range < 1:
             problems.append(f"clip_range={self.clip_range} must lie in (0, 1)")
-        for name in ("target_kl", "anchor", "success_bonus"):
+        for name in ("target_kl", "anchor", "success_bonus", "stall_margin_kt"):
             value = getattr(self, name)
             if not (value >= 0 and math.isfinite(value)):
                 problems.append(f"{name}={value} must be a number >= 0")

@@ -101,6 +101,7 @@ def _train(
             action["std"].tolist(),
             cfg.success_bonus,
             cfg.clock,
+            cfg.stall_margin_kt,
         )
         venv: Any = training_envs(env_fn, cfg.n_envs)
         venv.seed(cfg.seed)  # env k's first reset takes seed + k

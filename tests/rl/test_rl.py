@@ -311,3 +311,36 @@ def test_an_action_floor_widens_the_units_not_the_flight(bc_policy):
     torch.testing.assert_close(start.module.act(obs)[0], bc.act(obs)[0], atol=1e-5, rtol=0)
     with pytest.raises(ConfigError, match="action_floor"):
         PPORunConfig(init=bc_policy, action_floor=(0.0, 0.0, 0.0, 2.0))
+
+
+def test_the_stall_margin_costs_each_step_flown_near_the_stall(bc_policy):
+    from gymfg_il.rl.env import make_env
+    from gymfg_il.sim.properties import INDEX
+
+    spec = starting_flight(bc_policy)
+    pulled = np.array([0.0, -0.6, 0.0, 0.0])  # stick back, throttle idle: the speed bleeds
+    runs = []
+    for margin in (0.0, 15.0):
+        env = make_env(spec, [0.0] * 4, [1.0] * 4, stall_margin_kt=margin)  # raw actions
+        env.reset(seed=4)
+        rewards, speeds, done = [], [], False
+        while not done:
+            _, reward, terminated, truncated, info = env.step(pulled)
+            rewards.append(reward)
+            speeds.append(env.unwrapped.world.slots[0].state[INDEX["airspeed_kts"]])
+            done = terminated or truncated
+        runs.append((np.array(rewards), np.array(speeds), info))
+    (plain, speeds, info), (costed, same_speeds, _) = runs
+    assert info["reason"] == "stalled" and np.array_equal(speeds, same_speeds)
+    slow = speeds < 50.0 + 15.0  # the c172p stalls below 50 kt
+    assert slow.any() and not slow.all()
+    assert costed == pytest.approx(plain - slow.astype(float), abs=1e-12)
+    with pytest.raises(ConfigError, match="stall_margin_kt=-5"):
+        PPORunConfig(init=bc_policy, stall_margin_kt=-5)
+
+
+def starting_flight(bc_policy):
+    """The flight the cloned policy was trained on, as a spec (30-s altitude episodes)."""
+    from gymfg_il.rl.start import starting_policy
+
+    return starting_policy(PPORunConfig(init=bc_policy)).flight.to_dict()
