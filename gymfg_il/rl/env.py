@@ -113,13 +113,14 @@ class StallMargin(gym.Wrapper):
 
     def __init__(self, env: gym.Env, margin_kt: float, cost: float = 1.0) -> None:
         super().__init__(env)
-        self._flight: Any = env.unwrapped
-        self.floor_kt = self._flight.task.aircraft.profile.min_airspeed_kts + margin_kt
+        flight: Any = env.unwrapped
+        self._world = flight.world
+        self.floor_kt = flight.task.aircraft.profile.min_airspeed_kts + margin_kt
         self.cost = cost
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         obs, reward, terminated, truncated, info = self.env.step(action)
-        if self._flight.world.slots[0].state[_AIRSPEED] < self.floor_kt:
+        if self._world.slots[0].state[_AIRSPEED] < self.floor_kt:
             reward = float(reward) - self.cost
         return obs, float(reward), terminated, truncated, info
 
