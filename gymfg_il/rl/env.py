@@ -107,7 +107,7 @@ class StallMargin(gym.Wrapper):
     Ending an episode costs a policy only the reward it would have earned afterwards, which
     PPO's discount (about 10 s ahead) values at a few steps' worth. A c172p fine-tuned for the
     altitude in moderate turbulence learnt to climb at 25 degrees of pitch, bleeding 100 kt
-    to 50 in 11 s, and stalled on 2-3 of 16 held-out climbs where the BC start and the
+    to 50 in 11 s, and stalled in up to 3 of 16 held-out episodes where the BC start and the
     controller never did (docs/results/rl.md). The cost comes while the speed is being lost,
     within the discount's reach."""
 

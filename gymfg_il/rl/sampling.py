@@ -79,7 +79,10 @@ def sample_rollout(
 ) -> dict[str, Any]:
     """``n_steps`` steps of ``envs`` from their observations ``obs``, each action sampled by
     ``policy`` with ``weights``, as stable-baselines3's ``collect_rollouts`` samples and steps
-    them (the keys: ``GroupedVecEnv.rollout``; ``resets``, (env, info) of every reset)."""
+    them (the keys: ``GroupedVecEnv.rollout``; ``resets``, (env, info) of every reset). A
+    step runs only the actor (``NumpyActorCritic.sample``); the values and log-probabilities
+    of all the rollout's steps come in one batched pass at its end, the weights being the
+    same throughout."""
     policy.load(weights)
     space = envs[0].action_space
     assert isinstance(space, gym.spaces.Box)
