@@ -315,9 +315,10 @@ def test_an_action_floor_widens_the_units_not_the_flight(bc_policy):
 
 def test_the_stall_margin_costs_each_step_flown_near_the_stall(bc_policy):
     from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.start import starting_policy
     from gymfg_il.sim.properties import INDEX
 
-    spec = starting_flight(bc_policy)
+    spec = starting_policy(PPORunConfig(init=bc_policy)).flight.to_dict()  # 30-s altitude
     pulled = np.array([0.0, -0.6, 0.0, 0.0])  # stick back, throttle idle: the speed bleeds
     runs = []
     for margin in (0.0, 15.0):
@@ -337,10 +338,3 @@ def test_the_stall_margin_costs_each_step_flown_near_the_stall(bc_policy):
     assert costed == pytest.approx(plain - slow.astype(float), abs=1e-12)
     with pytest.raises(ConfigError, match="stall_margin_kt=-5"):
         PPORunConfig(init=bc_policy, stall_margin_kt=-5)
-
-
-def starting_flight(bc_policy):
-    """The flight the cloned policy was trained on, as a spec (30-s altitude episodes)."""
-    from gymfg_il.rl.start import starting_policy
-
-    return starting_policy(PPORunConfig(init=bc_policy)).flight.to_dict()
