@@ -96,10 +96,13 @@ def _ppo(args: argparse.Namespace) -> int:
     for note in start.notes:
         print(note, file=sys.stderr)
     flight = start.flight
+    kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.select_episodes - 1}"
+    keep = f"the kept actor the best on {kept_on}" if cfg.keep == "best" else "the last kept"
     print(
         f"PPO on {flight.task_label} on {flight.aircraft} ({flight.turbulence} turbulence): "
         f"{cfg.steps:,} env steps on {cfg.n_envs} env(s), evaluated every {cfg.eval_every:,} "
-        f"on seeds {cfg.eval_seed}..{cfg.eval_seed + cfg.eval_episodes - 1}",
+        f"on seeds {cfg.eval_seed}..{cfg.eval_seed + cfg.eval_episodes - 1} (the curve), "
+        f"{keep}",
         file=sys.stderr,
     )
     bar = cli.progress_bar(cfg.steps, "env steps", "step", not args.no_progress)
@@ -123,8 +126,9 @@ def _ppo(args: argparse.Namespace) -> int:
     kept = next(p for p in result.curve if p.step == result.kept_step)
     which = "the start" if kept.step == 0 else f"step {kept.step:,}"
     print(
-        f"policy saved to {result.out}: the actor of {which} ({cfg.keep} on the evaluation "
-        f"seeds: {100 * kept.success:.0f}% success; curve: {result.out / 'curve.png'})"
+        f"policy saved to {result.out}: the actor of {which} ({cfg.keep} on {kept.chosen_on} "
+        f"evaluation seeds: {100 * kept.select_success:.0f}% success; curve: "
+        f"{result.out / 'curve.png'})"
     )
     return 0
 

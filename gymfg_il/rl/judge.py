@@ -1,6 +1,11 @@
 """Evaluations during a PPO run (``Judge``): each actor is saved as a checkpoint and flown on
 the held-out seeds by ``evaluation.runner.evaluate``, the code ``eval`` runs, so every point of
-the curve is what ``eval --policy`` would report; and the curve's plot."""
+the curve is what ``eval --policy`` would report; and the curve's plot.
+
+The curve is the first ``eval_episodes`` seeds' success; the kept actor is chosen on more
+(``select_episodes``, those seeds and the next ones): on 16 episodes a success rate's spread is
+about 10 points, as wide as the actors' differences, and the best of twenty such draws is
+mostly the luckiest (docs/results/rl.md, "Choosing the kept actor on more episodes")."""
 
 from __future__ import annotations
 
@@ -16,13 +21,18 @@ from gymfg_il.rl.start import Start, as_ppo, meta_of, stats_of
 
 @dataclass
 class EvalPoint:
-    """One evaluation of the actor's mean action on the held-out seeds."""
+    """One evaluation of the actor's mean action: on the curve's held-out seeds (``success``,
+    ``mean_return``, ``crashed``) and on all the seeds the kept actor is chosen on
+    (``chosen_on`` episodes: ``select_success``, ``select_return``)."""
 
     step: int
     success: float
     mean_return: float
     crashed: int
     wall_s: float
+    select_success: float
+    select_return: float
+    chosen_on: int
 
 
 class Judge:
@@ -30,30 +40,49 @@ class Judge:
     every point of the curve is what ``eval --policy`` would report for it."""
 
     def __init__(
-        self, flight: FlightSpec, seeds: list[int], start: Start, folder: Path, began: float
+        self,
+        flight: FlightSpec,
+        seeds: list[int],
+        start: Start,
+        folder: Path,
+        began: float,
+        more: list[int] | None = None,
+        workers: Any = 1,
     ) -> None:
+        """``seeds``: the curve's; ``more``: the further seeds the kept actor is chosen on;
+        ``workers``: processes (or a ``workers.Workers`` pool) to fly them on."""
         self.flight, self.seeds, self.start, self.folder = flight, seeds, start, folder
-        self.began = began
+        self.more, self.workers, self.began = list(more or []), workers, began
         self.best: tuple[tuple[float, float], int, Any] | None = None  # score, step, actor
 
-    def _point(self, step: int, row: dict[str, Any]) -> EvalPoint:
+    def _fly(self, step: int, agent: Any, more: bool = True) -> EvalPoint:
+        from gymfg_il.evaluation.metrics import summarize
+        from gymfg_il.evaluation.runner import evaluate
+
+        seeds = self.seeds + (self.more if more else [])
+        rows, traces = evaluate(self.flight, {"agent": agent}, seeds, self.workers)
+        f = self.flight
+        curve: dict[str, Any] = summarize(
+            "agent", f.task_label, f.aircraft, traces["agent"][: len(self.seeds)]
+        )
         return EvalPoint(
             step,
-            float(row["success_rate"]),
-            float(row["mean_return"]),
-            int(row["terminated"]),
+            float(curve["success_rate"]),
+            float(curve["mean_return"]),
+            int(curve["terminated"]),
             time.perf_counter() - self.began,
+            float(rows[0]["success_rate"]),
+            float(rows[0]["mean_return"]),
+            len(seeds),
         )
 
     def controller(self) -> EvalPoint:
-        from gymfg_il.evaluation.runner import evaluate
+        """The controller on the curve's seeds (its line on the plot)."""
         from gymfg_il.rollout.agents import AgentSpec
 
-        rows, _ = evaluate(self.flight, {"controller": AgentSpec.controller()}, self.seeds)
-        return self._point(0, rows[0])
+        return self._fly(0, AgentSpec.controller(), more=False)
 
     def __call__(self, actor: Any, step: int) -> EvalPoint:
-        from gymfg_il.evaluation.runner import evaluate
         from gymfg_il.policies.checkpoint import save_policy
         from gymfg_il.rollout.agents import AgentSpec
 
@@ -63,18 +92,20 @@ class Judge:
         save_policy(
             module, path, meta, stats_of(module, "obs_norm"), stats_of(module, "action_norm")
         )
-        rows, _ = evaluate(self.flight, {"policy": AgentSpec.policy(path)}, self.seeds)
+        point = self._fly(step, AgentSpec.policy(path))
         shutil.rmtree(path, ignore_errors=True)
-        point = self._point(step, rows[0])
-        score = (point.success, point.mean_return)
+        score = (point.select_success, point.select_return)
         if self.best is None or score > self.best[0]:
             self.best = (score, step, module)
         return point
 
 
-def plot_curve(curve: list[EvalPoint], controller: EvalPoint, title: str, path: Path) -> None:
+def plot_curve(
+    curve: list[EvalPoint], controller: EvalPoint, title: str, path: Path, kept: int | None = None
+) -> None:
     """Evaluated success and return against env steps, with the start (the first point) and
-    the controller on the same seeds as lines."""
+    the controller on the same seeds as lines; the success on all the seeds the kept actor is
+    chosen on, where those are more, and the kept actor (step ``kept``) marked."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -82,21 +113,27 @@ def plot_curve(curve: list[EvalPoint], controller: EvalPoint, title: str, path: 
 
     steps = [p.step for p in curve]
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
-    for ax, key, label in zip(
-        axes, ("success", "mean_return"), ("success (held-out seeds)", "mean return"), strict=True
-    ):
-        values = [getattr(p, key) for p in curve]
-        if key == "success":
-            values = [100 * v for v in values]
-        ax.plot(steps, values, marker="o", label="policy")
-        first = values[0]
-        expert = getattr(controller, key) * (100 if key == "success" else 1)
-        ax.axhline(first, color="grey", linestyle="--", label="start")
+    panels = (
+        ("success", "select_success", "success (held-out seeds)"),
+        ("mean_return", "select_return", "mean return"),
+    )
+    for ax, (key, chosen_key, label) in zip(axes, panels, strict=True):
+        scale = 100 if key == "success" else 1
+        values = [scale * getattr(p, key) for p in curve]
+        ax.plot(steps, values, marker="o", label=f"policy ({controller.chosen_on} seeds)")
+        chosen = [scale * getattr(p, chosen_key) for p in curve]
+        if curve[0].chosen_on > controller.chosen_on:
+            ax.plot(steps, chosen, marker=".", alpha=0.7, label=f"on {curve[0].chosen_on} seeds")
+        for p, v in zip(curve, chosen, strict=True):
+            if p.step == kept:  # where it was chosen
+                ax.plot([p.step], [v], marker="*", markersize=14, color="red", label="kept")
+        ax.axhline(values[0], color="grey", linestyle="--", label="start")
+        expert = scale * getattr(controller, key)
         ax.axhline(expert, color="green", linestyle=":", label="controller")
         ax.set_xlabel("env steps")
         ax.set_ylabel(label + (" %" if key == "success" else ""))
         ax.grid(alpha=0.3)
-    axes[0].legend()
+    axes[0].legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=90)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import os
 import shutil
 import tempfile
 import time
@@ -38,6 +39,7 @@ from gymfg_il.rl.judge import EvalPoint, Judge, plot_curve
 from gymfg_il.rl.policy import AnchoredPolicy
 from gymfg_il.rl.start import Start, as_ppo, meta_of, starting_policy, stats_of
 from gymfg_il.rl.vec import GroupedVecEnv, training_envs
+from gymfg_il.workers import Workers
 
 log = logging.getLogger(__name__)
 
@@ -85,9 +87,14 @@ def _train(
     out = Path(cfg.out or f"policies/ppo-{flight.task}-{flight.aircraft}")
     check_out(out)  # before training, not after
     seeds = list(range(cfg.eval_seed, cfg.eval_seed + cfg.eval_episodes))
+    chosen = cfg.select_episodes if cfg.keep == "best" else cfg.eval_episodes
+    more = list(range(seeds[-1] + 1, cfg.eval_seed + chosen))
     began = time.perf_counter()
     scratch_dir = Path(tempfile.mkdtemp(prefix="gymfg-ppo-"))
-    judge = Judge(flight, seeds, start, scratch_dir, began)
+    # the evaluations' processes, started before the envs' (the env processes wait while an
+    # evaluation flies)
+    pool = Workers(min(2, len(os.sched_getaffinity(0)))) if more else Workers(1)
+    judge = Judge(flight, seeds, start, scratch_dir, began, more, pool)
     try:
         controller = judge.controller()
         curve = [judge(module, 0)]
@@ -138,6 +145,7 @@ def _train(
         _save(cfg, result, start, actor, scratch_dir / "tensorboard")
         return result
     finally:
+        pool.close()
         shutil.rmtree(scratch_dir, ignore_errors=True)
 
 
@@ -329,7 +337,11 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, tb: Pa
         "algorithm": "ppo (stable-baselines3)",
         "init": str(cfg.init) if cfg.init else None,
         "steps": result.steps,
-        "kept": {"which": cfg.keep, "step": result.kept_step},
+        "kept": {
+            "which": cfg.keep,
+            "step": result.kept_step,
+            "chosen_on": result.curve[-1].chosen_on,
+        },
         "wall_s": round(result.seconds, 1),
         "envs": cfg.n_envs,
         "settings": settings,
@@ -353,7 +365,9 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, tb: Pa
             )
             (folder / "curve.json").write_text(json.dumps(rl, indent=1))
             title = f"{name}: {flight.task_label} on {flight.aircraft}"
-            plot_curve(result.curve, result.controller, title, folder / "curve.png")
+            plot_curve(
+                result.curve, result.controller, title, folder / "curve.png", result.kept_step
+            )
             if tb.is_dir():
                 shutil.copytree(tb, folder / "tensorboard")
     except OSError as err:

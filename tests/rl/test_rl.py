@@ -29,7 +29,8 @@ def bc_policy(tiny_dataset, tmp_path_factory):
 def _short(bc_policy, out, **changes):
     settings = dict(
         init=bc_policy, out=out, steps=1024, envs=2, rollout_steps=256, batch_size=128,
-        epochs=2, eval_every=1024, eval_episodes=2, critic_warmup=256, seed=3,
+        epochs=2, eval_every=1024, eval_episodes=2, select_episodes=4, critic_warmup=256,
+        seed=3,
     )  # fmt: skip
     return PPORunConfig(**{**settings, **changes})
 
@@ -71,9 +72,11 @@ def _bounds(env):
 def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     from safetensors.torch import load_file
 
+    from gymfg_il.envs.flight import FlightSpec
     from gymfg_il.evaluation.config import EvalConfig
-    from gymfg_il.evaluation.runner import run_eval
+    from gymfg_il.evaluation.runner import evaluate, run_eval
     from gymfg_il.rl.run import train_ppo
+    from gymfg_il.rollout.agents import AgentSpec
 
     out = tmp_path / "ppo"
     result = train_ppo(_short(bc_policy, out, turbulence="light"))
@@ -86,9 +89,17 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     assert config["rl"]["settings"]["actor_lr"] == 1e-4  # the rate applied, not None
     assert (out / "curve.png").stat().st_size > 1000
     assert list((out / "tensorboard").rglob("events.out.tfevents.*"))
-    # the best evaluation's actor is kept (the start's, where nothing beat it)
-    best = max(result.curve, key=lambda p: (p.success, p.mean_return))
-    assert config["rl"]["kept"] == {"which": "best", "step": best.step}
+    # the best evaluation's actor is kept (the start's, where nothing beat it), chosen on the
+    # curve's two seeds and the next two: the start's point is the BC policy's on each
+    best = max(result.curve, key=lambda p: (p.select_success, p.select_return))
+    assert config["rl"]["kept"] == {"which": "best", "step": best.step, "chosen_on": 4}
+    flight = FlightSpec.from_dict(config["spec"])  # the run's: in light turbulence
+    for seeds, success, mean_return in (
+        ([7000, 7001], result.curve[0].success, result.curve[0].mean_return),
+        ([7000, 7001, 7002, 7003], result.curve[0].select_success, result.curve[0].select_return),
+    ):
+        rows, _ = evaluate(flight, {"bc": AgentSpec.policy(bc_policy)}, seeds)
+        assert (rows[0]["success_rate"], rows[0]["mean_return"]) == (success, mean_return)
     kept = load_file(str(out / "model.safetensors"))
     start = load_file(str(bc_policy / "model.safetensors"))
     assert set(kept) == set(start)
@@ -191,6 +202,12 @@ def test_the_discount_looks_as_far_ahead_in_seconds_at_every_rate(bc_policy):
     assert given.discounts(30) == (0.98, 0.9)
     with pytest.raises(ConfigError, match=r"gamma=1\.5"):
         PPORunConfig(init=bc_policy, gamma=1.5)
+
+
+def test_the_kept_actor_is_chosen_on_the_curves_seeds_and_more(bc_policy):
+    assert PPORunConfig(init=bc_policy).select_episodes == 64  # 16 spreads ~10 points
+    with pytest.raises(ConfigError, match="select_episodes=8 must be >= eval_episodes=16"):
+        PPORunConfig(init=bc_policy, select_episodes=8)
 
 
 def test_what_cannot_be_fine_tuned_is_refused(bc_policy, tiny_dataset, tmp_path):
