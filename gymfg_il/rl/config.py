@@ -56,6 +56,8 @@ class PPORunConfig:
             return) on the select_episodes seeds, the start included, so the result never
             flies worse than the start on these seeds; or ``last``, the actor as training
             left it. Judge the result on other seeds (``eval --seed``).
+        checkpoints: keep every evaluated actor, a policy in OUT/checkpoints/step-N (about
+            0.6 MB each), to fly again (``eval --policy``) or choose on other seeds.
         rollout_steps: steps each env samples between updates (PPO's n_steps).
         batch_size: samples per gradient step.
         epochs: passes over each rollout per update.
@@ -128,6 +130,7 @@ class PPORunConfig:
     eval_seed: int = 7000
     select_episodes: int = 64
     keep: Literal["best", "last"] = "best"
+    checkpoints: bool = False
     rollout_steps: int = 512
     batch_size: int = 512
     epochs: int = 10

@@ -48,11 +48,14 @@ class Judge:
         began: float,
         more: list[int] | None = None,
         workers: Any = 1,
+        keep_all: bool = False,
     ) -> None:
         """``seeds``: the curve's; ``more``: the further seeds the kept actor is chosen on;
-        ``workers``: processes (or a ``workers.Workers`` pool) to fly them on."""
+        ``workers``: processes (or a ``workers.Workers`` pool) to fly them on; ``keep_all``:
+        every evaluated actor stays in ``folder``/checkpoints/step-N."""
         self.flight, self.seeds, self.start, self.folder = flight, seeds, start, folder
         self.more, self.workers, self.began = list(more or []), workers, began
+        self.keep_all = keep_all
         self.best: tuple[tuple[float, float], int, Any] | None = None  # score, step, actor
 
     def _fly(self, step: int, agent: Any, more: bool = True) -> EvalPoint:
@@ -86,14 +89,15 @@ class Judge:
         from gymfg_il.policies.checkpoint import save_policy
         from gymfg_il.rollout.agents import AgentSpec
 
-        path = self.folder / f"step-{step}"
+        path = self.folder / ("checkpoints" if self.keep_all else "") / f"step-{step}"
         module = as_ppo(actor)
         meta = {**meta_of(self.start), "name": path.name, "spec": self.flight.to_dict()}
         save_policy(
             module, path, meta, stats_of(module, "obs_norm"), stats_of(module, "action_norm")
         )
         point = self._fly(step, AgentSpec.policy(path))
-        shutil.rmtree(path, ignore_errors=True)
+        if not self.keep_all:
+            shutil.rmtree(path, ignore_errors=True)
         score = (point.select_success, point.select_return)
         if self.best is None or score > self.best[0]:
             self.best = (score, step, module)

@@ -94,7 +94,7 @@ def _train(
     # the evaluations' processes, started before the envs' (the env processes wait while an
     # evaluation flies)
     pool = Workers(min(2, len(os.sched_getaffinity(0)))) if more else Workers(1)
-    judge = Judge(flight, seeds, start, scratch_dir, began, more, pool)
+    judge = Judge(flight, seeds, start, scratch_dir, began, more, pool, cfg.checkpoints)
     try:
         controller = judge.controller()
         curve = [judge(module, 0)]
@@ -142,7 +142,7 @@ def _train(
             (judge.best[1], judge.best[2]) if cfg.keep == "best" else (curve[-1].step, last)
         )
         result = PPOResult(out, model.num_timesteps, seconds, curve, controller, start.notes, step)
-        _save(cfg, result, start, actor, scratch_dir / "tensorboard")
+        _save(cfg, result, start, actor, scratch_dir)
         return result
     finally:
         pool.close()
@@ -319,9 +319,10 @@ class _Watch(BaseCallback):
             self.on_eval(point)
 
 
-def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, tb: Path) -> None:
+def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, scratch: Path) -> None:
     """The policy folder: config.json and model.safetensors (a ``ppo`` policy), the curve
-    (curve.json, curve.png) and the TensorBoard log, saved whole or not at all."""
+    (curve.json, curve.png), the TensorBoard log and, if asked, every evaluated actor
+    (checkpoints/), saved whole or not at all."""
     from gymfg_il.learning.saving import check_diverged
     from gymfg_il.policies.checkpoint import save_policy
     from gymfg_il.policies.checkpoint_folder import staged
@@ -368,8 +369,9 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, tb: Pa
             plot_curve(
                 result.curve, result.controller, title, folder / "curve.png", result.kept_step
             )
-            if tb.is_dir():
-                shutil.copytree(tb, folder / "tensorboard")
+            for part in ("tensorboard", "checkpoints"):
+                if (scratch / part).is_dir():
+                    shutil.copytree(scratch / part, folder / part)
     except OSError as err:
         raise ConfigError(
             f"cannot save the policy to {result.out} ({err}); free some space or give another --out"

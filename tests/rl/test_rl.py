@@ -79,7 +79,7 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     from gymfg_il.rollout.agents import AgentSpec
 
     out = tmp_path / "ppo"
-    result = train_ppo(_short(bc_policy, out, turbulence="light"))
+    result = train_ppo(_short(bc_policy, out, turbulence="light", checkpoints=True))
     assert result.steps >= 1024
     assert [p.step for p in result.curve] == [0, 1024]
     config = json.loads((out / "config.json").read_text())
@@ -105,6 +105,12 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     assert set(kept) == set(start)
     same = all(torch.equal(kept[k], start[k]) for k in start)
     assert same == (best.step == 0)
+    # every evaluated actor kept, as asked: the kept one among them, the start as it was
+    steps = sorted(int(p.name.split("-")[1]) for p in (out / "checkpoints").iterdir())
+    assert steps == [p.step for p in result.curve]
+    for step, want in ((best.step, kept), (0, start)):
+        saved = load_file(str(out / "checkpoints" / f"step-{step}" / "model.safetensors"))
+        assert all(torch.equal(saved[k], want[k]) for k in want)
     # eval flies it beside the policy it started from, in the weather the flags give
     run = run_eval(EvalConfig(policy=[out, bc_policy], episodes=2, seed=9000, turbulence="none"))
     assert [r["agent"] for r in run.rows] == ["controller", "policy:ppo", "policy:bc"]
