@@ -96,7 +96,7 @@ def _ppo(args: argparse.Namespace) -> int:
     for note in start.notes:
         print(note, file=sys.stderr)
     flight = start.flight
-    kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.select_episodes - 1}"
+    kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
     keep = f"the kept actor the best on {kept_on}" if cfg.keep == "best" else "the last kept"
     print(
         f"PPO on {flight.task_label} on {flight.aircraft} ({flight.turbulence} turbulence): "

@@ -15,6 +15,8 @@ from gymfg_il.typecheck import type_problems
 ANCHOR_SPAN_MAX = 150_000  # the longest the anchor decays over by default (``anchor_steps``)
 # the actor's default learning rate when fine-tuning (``actor_lr``); from scratch it is ``lr``
 FINE_TUNE_ACTOR_LR = 1e-4
+# the episodes the kept actor is chosen on by default (``select_episodes``)
+SELECT_EPISODES = 64
 # the default discount and GAE lambda per step at DISCOUNT_HZ, kept per second at other rates
 DEFAULT_GAMMA, DEFAULT_GAE_LAMBDA, DISCOUNT_HZ = 0.99, 0.95, 10
 
@@ -48,10 +50,11 @@ class PPORunConfig:
         eval_seed: the first held-out seed.
         select_episodes: episodes each evaluation flies to choose the kept actor (with
             --keep best): the curve's eval_episodes seeds and the next ones after them (seeds
-            eval_seed .. eval_seed + select_episodes - 1), on two processes. On 16 episodes a
-            success rate spreads about 10 points, as much as the actors differ, and the best
-            of twenty such draws is mostly the luckiest (docs/results/rl.md). Equal to
-            eval_episodes: chosen on the curve's seeds alone.
+            eval_seed .. eval_seed + select_episodes - 1), on two processes (default: 64, or
+            eval_episodes if more). On 16 episodes a success rate spreads about 10 points, as
+            much as the actors differ, and the best of twenty such draws is mostly the
+            luckiest (docs/results/rl.md). Equal to eval_episodes: chosen on the curve's
+            seeds alone.
         keep: which actor is saved: ``best``, the evaluation with the highest success (then
             return) on the select_episodes seeds, the start included, so the result never
             flies worse than the start on these seeds; or ``last``, the actor as training
@@ -128,7 +131,7 @@ class PPORunConfig:
     eval_every: int = 50_000
     eval_episodes: int = 16
     eval_seed: int = 7000
-    select_episodes: int = 64
+    select_episodes: int | None = None
     keep: Literal["best", "last"] = "best"
     checkpoints: bool = False
     rollout_steps: int = 512
@@ -168,7 +171,7 @@ class PPORunConfig:
         for name in positive:
             if getattr(self, name) < 1:
                 problems.append(f"{name}={getattr(self, name)} must be >= 1")
-        if self.select_episodes < self.eval_episodes:
+        if self.select_episodes is not None and self.select_episodes < self.eval_episodes:
             problems.append(
                 f"select_episodes={self.select_episodes} must be >= eval_episodes="
                 f"{self.eval_episodes} (the kept actor is chosen on the curve's seeds and more)"
@@ -216,6 +219,16 @@ class PPORunConfig:
     def n_envs(self) -> int:
         """The envs sampled in parallel: ``envs``, else four per CPU core."""
         return self.envs or 4 * len(os.sched_getaffinity(0))
+
+    @property
+    def chosen_on(self) -> int:
+        """Episodes each evaluation flies: those the kept actor is chosen on (``keep`` best),
+        else the curve's."""
+        if self.keep == "last":
+            return self.eval_episodes
+        if self.select_episodes is not None:
+            return self.select_episodes
+        return max(SELECT_EPISODES, self.eval_episodes)
 
     @property
     def rollout(self) -> int:

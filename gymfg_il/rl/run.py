@@ -87,8 +87,7 @@ def _train(
     out = Path(cfg.out or f"policies/ppo-{flight.task}-{flight.aircraft}")
     check_out(out)  # before training, not after
     seeds = list(range(cfg.eval_seed, cfg.eval_seed + cfg.eval_episodes))
-    chosen = cfg.select_episodes if cfg.keep == "best" else cfg.eval_episodes
-    more = list(range(seeds[-1] + 1, cfg.eval_seed + chosen))
+    more = list(range(seeds[-1] + 1, cfg.eval_seed + cfg.chosen_on))
     began = time.perf_counter()
     scratch_dir = Path(tempfile.mkdtemp(prefix="gymfg-ppo-"))
     # the evaluations' processes, started before the envs' (the env processes wait while an

@@ -211,7 +211,9 @@ def test_the_discount_looks_as_far_ahead_in_seconds_at_every_rate(bc_policy):
 
 
 def test_the_kept_actor_is_chosen_on_the_curves_seeds_and_more(bc_policy):
-    assert PPORunConfig(init=bc_policy).select_episodes == 64  # 16 spreads ~10 points
+    assert PPORunConfig(init=bc_policy).chosen_on == 64  # 16 spreads ~10 points
+    assert PPORunConfig(init=bc_policy, eval_episodes=100).chosen_on == 100
+    assert PPORunConfig(init=bc_policy, keep="last").chosen_on == 16  # nothing to choose
     with pytest.raises(ConfigError, match="select_episodes=8 must be >= eval_episodes=16"):
         PPORunConfig(init=bc_policy, select_episodes=8)
 
