@@ -108,6 +108,10 @@ class PPORunConfig:
             (where the task ends an episode) plus this many knots costs a step's whole task
             reward (1): a stall otherwise costs only the reward after it, a few steps' worth
             at PPO's discount (0: no cost; docs/results/rl.md).
+        bank_limit_deg: each training step banked beyond this many degrees either way costs
+            a step's whole task reward (1): a turn fine-tuned without it banked hard, lost
+            the altitude in its first seconds and chattered about the new heading (0: no
+            cost; the c172p's maneuvers bank 25 degrees; docs/results/rl.md).
         anchor: weight, at the start, of the squared distance between the actor's mean action
             and the starting policy's (normalised units) added to PPO's loss; it decays
             linearly to 0 over anchor_steps (0: no anchor). Not used from scratch.
@@ -151,6 +155,7 @@ class PPORunConfig:
     success_bonus: float = 0.2
     clock: bool = False
     stall_margin_kt: float = 0.0
+    bank_limit_deg: float = 0.0
     anchor: float = 1.0
     anchor_steps: int | None = None
     critic: list[int] = field(default_factory=lambda: [256, 256])
@@ -192,6 +197,8 @@ class PPORunConfig:
                 problems.append(f"{name}={value} must lie in (0, 1]")
         if not 0 < self.clip_range < 1:
             problems.append(f"clip_range={self.clip_range} must lie in (0, 1)")
+        if not 0 <= self.bank_limit_deg < 180:
+            problems.append(f"bank_limit_deg={self.bank_limit_deg}: want 0 (off) up to 180")
         for name in ("target_kl", "anchor", "success_bonus", "stall_margin_kt"):
             value = getattr(self, name)
             if not (value >= 0 and math.isfinite(value)):

@@ -1,7 +1,7 @@
 """The env PPO trains in (``rl.run``): the policy's own flight, taking actions in the
 policy's normalised units (``NormalizedActions``), judged at the end of each episode as
 ``eval`` judges it, with a bonus on success (``SuccessBonus``) and, if asked, a cost for
-flying near the stall speed (``StallMargin``).
+flying near the stall speed (``StallMargin``) or banked steeply (``BankLimit``).
 
 The task's reward is shaped for flying near the target, and most of an episode's return
 comes on the way there: a policy that reaches the target and then wanders outside its
@@ -23,7 +23,7 @@ from gymfg_il.sim.properties import INDEX
 from gymfg_il.sim.timing import episode_steps
 from gymfg_il.tasks.verdicts import judge_flight
 
-_AIRSPEED = INDEX["airspeed_kts"]
+_AIRSPEED, _ROLL = INDEX["airspeed_kts"], INDEX["roll_deg"]
 
 
 class NormalizedActions(gym.ActionWrapper):
@@ -125,6 +125,28 @@ class StallMargin(gym.Wrapper):
         return obs, float(reward), terminated, truncated, info
 
 
+class BankLimit(gym.Wrapper):
+    """Each step banked beyond ``limit_deg`` either way costs ``cost`` (1: about a step's
+    whole task reward).
+
+    The turn's reward pays for the heading turned, so a policy fine-tuned on it learnt to
+    bank hard: the altitude went in the first seconds of a steep turn, and the roll swung
+    +-30 degrees about the new heading to the end (docs/results/rl.md). The controller banks
+    25 degrees at most in the maneuvers."""
+
+    def __init__(self, env: gym.Env, limit_deg: float, cost: float = 1.0) -> None:
+        super().__init__(env)
+        flight: Any = env.unwrapped
+        self._world = flight.world
+        self.limit_deg, self.cost = limit_deg, cost
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        if abs(self._world.slots[0].state[_ROLL]) > self.limit_deg:
+            reward = float(reward) - self.cost
+        return obs, float(reward), terminated, truncated, info
+
+
 class EpisodeClock(gym.Wrapper):
     """Appends the share of the episode flown (0 at the reset, 1 at the time limit) to the
     observation, and makes the time limit the episode's end (``terminated``), not a cut.
@@ -169,12 +191,14 @@ def make_env(
     success_bonus: float = 0.0,
     clock: bool = False,
     stall_margin_kt: float = 0.0,
+    bank_limit_deg: float = 0.0,
 ) -> gym.Env:
     """One training env (picklable, built in its own process): the flight ``spec`` taking
     actions in the policy's normalised units, its episodes' task returns logged
     (stable-baselines3's ``Monitor``, ``rollout/ep_rew_mean``: without the bonus or the
-    stall margin's cost), with ``success_bonus`` judged, ``stall_margin_kt`` charged
-    (``StallMargin``) and with ``clock`` timed (``EpisodeClock``)."""
+    stall margin's cost), with ``success_bonus`` judged, ``stall_margin_kt`` and
+    ``bank_limit_deg`` charged (``StallMargin``, ``BankLimit``) and with ``clock`` timed
+    (``EpisodeClock``)."""
     from stable_baselines3.common.monitor import Monitor
 
     flight = FlightSpec.from_dict(spec)
@@ -184,6 +208,8 @@ def make_env(
         out = SuccessBonus(out, success_bonus)
     if stall_margin_kt:
         out = StallMargin(out, stall_margin_kt)
+    if bank_limit_deg:
+        out = BankLimit(out, bank_limit_deg)
     if clock:
         out = EpisodeClock(out, episode_steps(flight.episode_time_s, flight.agent_hz))
     return out

@@ -108,6 +108,7 @@ def _train(
             cfg.success_bonus,
             cfg.clock,
             cfg.stall_margin_kt,
+            cfg.bank_limit_deg,
         )
         venv: Any = training_envs(env_fn, cfg.n_envs)
         venv.seed(cfg.seed)  # env k's first reset takes seed + k

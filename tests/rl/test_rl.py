@@ -363,3 +363,31 @@ def test_the_stall_margin_costs_each_step_flown_near_the_stall(bc_policy):
     assert costed == pytest.approx(plain - slow.astype(float), abs=1e-12)
     with pytest.raises(ConfigError, match="stall_margin_kt=-5"):
         PPORunConfig(init=bc_policy, stall_margin_kt=-5)
+
+
+def test_the_bank_limit_costs_each_step_banked_beyond_it(bc_policy):
+    from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.start import starting_policy
+    from gymfg_il.sim.properties import INDEX
+
+    spec = starting_policy(PPORunConfig(init=bc_policy)).flight.to_dict()
+    rolled = np.array([0.4, 0.0, 0.0, 0.7])  # aileron held: the bank grows past the limit
+    runs = []
+    for limit in (0.0, 35.0):
+        env = make_env(spec, [0.0] * 4, [1.0] * 4, bank_limit_deg=limit)  # raw actions
+        env.reset(seed=4)
+        rewards, banks = [], []
+        for _ in range(60):
+            _, reward, terminated, truncated, _ = env.step(rolled)
+            rewards.append(reward)
+            banks.append(env.unwrapped.world.slots[0].state[INDEX["roll_deg"]])
+            if terminated or truncated:
+                break
+        runs.append((np.array(rewards), np.array(banks)))
+    (plain, banks), (costed, same_banks) = runs
+    assert np.array_equal(banks, same_banks)
+    steep = np.abs(banks) > 35.0
+    assert steep.any() and not steep.all()
+    assert costed == pytest.approx(plain - steep.astype(float), abs=1e-12)
+    with pytest.raises(ConfigError, match="bank_limit_deg=-5"):
+        PPORunConfig(init=bc_policy, bank_limit_deg=-5)
