@@ -99,7 +99,26 @@ class SuccessBonus(gym.Wrapper):
         return success
 
 
-class StallMargin(gym.Wrapper):
+class StepCost(gym.Wrapper):
+    """Each step whose resulting state ``charged`` says yes to costs ``cost`` (1: about a
+    step's whole task reward); the flights subclass it with their rule."""
+
+    def __init__(self, env: gym.Env, cost: float = 1.0) -> None:
+        super().__init__(env)
+        flight: Any = env.unwrapped
+        self._flight, self._world, self.cost = flight, flight.world, cost
+
+    def charged(self, state: np.ndarray) -> bool:
+        raise NotImplementedError
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        if self.charged(self._world.slots[0].state):
+            reward = float(reward) - self.cost
+        return obs, float(reward), terminated, truncated, info
+
+
+class StallMargin(StepCost):
     """Each step flown slower than the aircraft's stall speed (``FlightProfile``'s
     ``min_airspeed_kts``, where the task ends an episode as stalled) plus ``margin_kt`` costs
     ``cost`` (1: about a step's whole task reward).
@@ -112,20 +131,14 @@ class StallMargin(gym.Wrapper):
     within the discount's reach."""
 
     def __init__(self, env: gym.Env, margin_kt: float, cost: float = 1.0) -> None:
-        super().__init__(env)
-        flight: Any = env.unwrapped
-        self._world = flight.world
-        self.floor_kt = flight.task.aircraft.profile.min_airspeed_kts + margin_kt
-        self.cost = cost
+        super().__init__(env, cost)
+        self.floor_kt = self._flight.task.aircraft.profile.min_airspeed_kts + margin_kt
 
-    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
-        obs, reward, terminated, truncated, info = self.env.step(action)
-        if self._world.slots[0].state[_AIRSPEED] < self.floor_kt:
-            reward = float(reward) - self.cost
-        return obs, float(reward), terminated, truncated, info
+    def charged(self, state: np.ndarray) -> bool:
+        return bool(state[_AIRSPEED] < self.floor_kt)
 
 
-class BankLimit(gym.Wrapper):
+class BankLimit(StepCost):
     """Each step banked beyond ``limit_deg`` either way costs ``cost`` (1: about a step's
     whole task reward).
 
@@ -135,16 +148,11 @@ class BankLimit(gym.Wrapper):
     25 degrees at most in the maneuvers."""
 
     def __init__(self, env: gym.Env, limit_deg: float, cost: float = 1.0) -> None:
-        super().__init__(env)
-        flight: Any = env.unwrapped
-        self._world = flight.world
-        self.limit_deg, self.cost = limit_deg, cost
+        super().__init__(env, cost)
+        self.limit_deg = limit_deg
 
-    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
-        obs, reward, terminated, truncated, info = self.env.step(action)
-        if abs(self._world.slots[0].state[_ROLL]) > self.limit_deg:
-            reward = float(reward) - self.cost
-        return obs, float(reward), terminated, truncated, info
+    def charged(self, state: np.ndarray) -> bool:
+        return bool(abs(state[_ROLL]) > self.limit_deg)
 
 
 class EpisodeClock(gym.Wrapper):
