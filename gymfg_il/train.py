@@ -97,7 +97,12 @@ def _ppo(args: argparse.Namespace) -> int:
         print(note, file=sys.stderr)
     flight = start.flight
     kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
-    keep = f"the kept actor the best on {kept_on}" if cfg.keep == "best" else "the last kept"
+    keep = {
+        "best": f"the kept actor the best on {kept_on}",
+        "last": "the last kept",
+        "average": f"the kept actor the mean of those from step {cfg.average_start:,} on, "
+        f"flown on {kept_on}",
+    }[cfg.keep]
     print(
         f"PPO on {flight.task_label} on {flight.aircraft} ({flight.turbulence} turbulence): "
         f"{cfg.steps:,} env steps on {cfg.n_envs} env(s), evaluated every {cfg.eval_every:,} "
@@ -123,12 +128,16 @@ def _ppo(args: argparse.Namespace) -> int:
         f"{100 * expert.success:.0f}%), return {first.mean_return:.1f} -> "
         f"{last.mean_return:.1f} (controller {expert.mean_return:.1f})"
     )
-    kept = next(p for p in result.curve if p.step == result.kept_step)
-    which = "the start" if kept.step == 0 else f"step {kept.step:,}"
+    kept, averaged = result.kept, result.averaged
+    if averaged:
+        which = f"the mean of the {len(averaged)} actors of steps {averaged[0]:,}..{averaged[-1]:,}"
+    else:
+        which = "the actor of " + ("the start" if kept.step == 0 else f"step {kept.step:,}")
+        if cfg.keep == "average":  # the average succeeded less than the start
+            which += " (the average flew worse on these seeds)"
     print(
-        f"policy saved to {result.out}: the actor of {which} ({cfg.keep} on {kept.chosen_on} "
-        f"evaluation seeds: {100 * kept.select_success:.0f}% success; curve: "
-        f"{result.out / 'curve.png'})"
+        f"policy saved to {result.out}: {which} ({100 * kept.select_success:.0f}% success on "
+        f"{kept.chosen_on} evaluation seeds; curve: {result.out / 'curve.png'})"
     )
     return 0
 

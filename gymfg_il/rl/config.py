@@ -49,16 +49,23 @@ class PPORunConfig:
             1, ...), the same every time, with the controller on them once.
         eval_seed: the first held-out seed.
         select_episodes: episodes each evaluation flies to choose the kept actor (with
-            --keep best): the curve's eval_episodes seeds and the next ones after them (seeds
-            eval_seed .. eval_seed + select_episodes - 1), on two processes (default: 64, or
-            eval_episodes if more). On 16 episodes a success rate spreads about 10 points, as
-            much as the actors differ, and the best of twenty such draws is mostly the
-            luckiest (docs/results/rl.md). Equal to eval_episodes: chosen on the curve's
-            seeds alone.
+            --keep best; with --keep average the start and the average fly them, the other
+            evaluations the curve's alone): the curve's eval_episodes seeds and the next
+            ones (seeds eval_seed .. eval_seed + select_episodes - 1), on two processes
+            (default: 64, or eval_episodes if more). On 16 episodes a success rate spreads
+            about 10 points, as much as the actors differ, and the best of twenty such draws
+            is mostly the luckiest (docs/results/rl.md). Equal to eval_episodes: chosen on
+            the curve's seeds alone.
         keep: which actor is saved: ``best``, the evaluation with the highest success (then
             return) on the select_episodes seeds, the start included, so the result never
-            flies worse than the start on these seeds; or ``last``, the actor as training
-            left it. Judge the result on other seeds (``eval --seed``).
+            flies worse than the start on these seeds; ``average``, the mean of the weights
+            of the actors evaluated from average_from of the run on (the last one included),
+            flown on the select_episodes seeds and kept unless it flies worse there than
+            the start (by success, then return; then the start is kept); or ``last``, the
+            actor as training left it.
+            Judge the result on other seeds (``eval --seed``).
+        average_from: with --keep average, the share of the run from which the evaluated
+            actors are averaged (0.5: those of its second half).
         checkpoints: keep every evaluated actor, a policy in OUT/checkpoints/step-N (about
             0.6 MB each), to fly again (``eval --policy``) or choose on other seeds.
         rollout_steps: steps each env samples between updates (PPO's n_steps).
@@ -136,7 +143,8 @@ class PPORunConfig:
     eval_episodes: int = 16
     eval_seed: int = 7000
     select_episodes: int | None = None
-    keep: Literal["best", "last"] = "best"
+    keep: Literal["best", "last", "average"] = "best"
+    average_from: float = 0.5
     checkpoints: bool = False
     rollout_steps: int = 512
     batch_size: int = 512
@@ -195,6 +203,10 @@ class PPORunConfig:
             value = getattr(self, name)
             if value is not None and not 0 < value <= 1:
                 problems.append(f"{name}={value} must lie in (0, 1]")
+        if not 0 <= self.average_from < 1:
+            problems.append(
+                f"average_from={self.average_from} must lie in [0, 1) (a share of the run)"
+            )
         if not 0 < self.clip_range < 1:
             problems.append(f"clip_range={self.clip_range} must lie in (0, 1)")
         if not 0 <= self.bank_limit_deg < 180:
@@ -236,6 +248,11 @@ class PPORunConfig:
         if self.select_episodes is not None:
             return self.select_episodes
         return max(SELECT_EPISODES, self.eval_episodes)
+
+    @property
+    def average_start(self) -> int | None:
+        """With keep ``average``: the env step from which evaluated actors are averaged."""
+        return int(self.steps * self.average_from) if self.keep == "average" else None
 
     @property
     def rollout(self) -> int:

@@ -5,7 +5,11 @@ the curve is what ``eval --policy`` would report; and the curve's plot.
 The curve is the first ``eval_episodes`` seeds' success; the kept actor is chosen on more
 (``select_episodes``, those seeds and the next ones): on 16 episodes a success rate's spread is
 about 10 points, as wide as the actors' differences, and the best of twenty such draws is
-mostly the luckiest (docs/results/rl.md, "Choosing the kept actor on more episodes")."""
+mostly the luckiest (docs/results/rl.md, "Choosing the kept actor on more episodes"). Or the
+kept actor is the mean of the weights of the actors evaluated in the run's late part
+(``Judge.average``): one actor's luck on a few episodes no longer picks it, and the average
+flew better held out than the actor chosen on 64 episodes (docs/results/rl.md, "Averaging the
+late actors")."""
 
 from __future__ import annotations
 
@@ -49,14 +53,18 @@ class Judge:
         more: list[int] | None = None,
         workers: Any = 1,
         keep_all: bool = False,
+        average_from: int | None = None,
     ) -> None:
         """``seeds``: the curve's; ``more``: the further seeds the kept actor is chosen on;
         ``workers``: processes (or a ``workers.Workers`` pool) to fly them on; ``keep_all``:
-        every evaluated actor stays in ``folder``/checkpoints/step-N."""
+        every evaluated actor stays in ``folder``/checkpoints/step-N; ``average_from``: the
+        actors evaluated from this env step on are kept for ``average`` (None: none)."""
         self.flight, self.seeds, self.start, self.folder = flight, seeds, start, folder
         self.more, self.workers, self.began = list(more or []), workers, began
-        self.keep_all = keep_all
+        self.keep_all, self.average_from = keep_all, average_from
         self.best: tuple[tuple[float, float], int, Any] | None = None  # score, step, actor
+        self.first: Any = None  # the start's actor (the first evaluated)
+        self.tail: list[tuple[int, dict[str, Any]]] = []  # (step, weights) to average
 
     def _fly(self, step: int, agent: Any, more: bool = True) -> EvalPoint:
         from gymfg_il.evaluation.metrics import summarize
@@ -85,31 +93,88 @@ class Judge:
 
         return self._fly(0, AgentSpec.controller(), more=False)
 
-    def __call__(self, actor: Any, step: int) -> EvalPoint:
+    def __call__(self, actor: Any, step: int, more: bool = True, name: str = "") -> EvalPoint:
+        """``actor`` evaluated at env ``step``, on the curve's seeds and (``more``) the
+        further ones. Named (``name``: the average), it is flown and saved under that name,
+        and is no candidate for ``best`` or ``average``."""
         from gymfg_il.policies.checkpoint import save_policy
         from gymfg_il.rollout.agents import AgentSpec
 
-        path = self.folder / ("checkpoints" if self.keep_all else "") / f"step-{step}"
+        name = name or f"step-{step}"
+        path = self.folder / ("checkpoints" if self.keep_all else "") / name
         module = as_ppo(actor)
         meta = {**meta_of(self.start), "name": path.name, "spec": self.flight.to_dict()}
         save_policy(
             module, path, meta, stats_of(module, "obs_norm"), stats_of(module, "action_norm")
         )
-        point = self._fly(step, AgentSpec.policy(path))
+        point = self._fly(step, AgentSpec.policy(path), more)
         if not self.keep_all:
             shutil.rmtree(path, ignore_errors=True)
+        if name != f"step-{step}":
+            return point
+        if self.first is None:
+            self.first = module
+        if self.average_from is not None and step >= self.average_from and step > 0:
+            weights = {k: v.detach().clone() for k, v in module.state_dict().items()}
+            self.tail.append((step, weights))
         score = (point.select_success, point.select_return)
         if self.best is None or score > self.best[0]:
             self.best = (score, step, module)
         return point
 
+    def average(self) -> Any:
+        """The start's network with the mean of the weights of the actors evaluated from
+        ``average_from`` on (computed in float64: the normalisations, the same in all, stay
+        exactly as they are)."""
+        import copy
+
+        import torch
+
+        if not self.tail or self.first is None:
+            raise RuntimeError("no evaluated actor to average: evaluate some first")
+        module = copy.deepcopy(self.first)
+        parts = [weights for _, weights in self.tail]
+        mean = {
+            k: torch.stack([w[k].double() for w in parts]).mean(0).to(v.dtype)
+            if v.is_floating_point()
+            else v
+            for k, v in parts[-1].items()
+        }
+        module.load_state_dict(mean)
+        return module
+
+
+def choose(keep: str, judge: Judge, curve: list[EvalPoint], last: Any) -> tuple[Any, ...]:
+    """(the kept actor's evaluation, the actor, the steps averaged into it: none unless
+    ``keep`` is ``average``) for ``PPORunConfig.keep``, ``last`` the actor after the last
+    update (evaluated last in ``curve``). The average is flown on all the selection seeds,
+    and the start is kept instead where it flew better there (by success, then return, as
+    ``best`` orders them)."""
+    if keep == "last":
+        return curve[-1], last, []
+    if keep == "best":
+        assert judge.best is not None
+        _, step, actor = judge.best
+        return next(p for p in curve if p.step == step), actor, []
+    average = judge.average()
+    point = judge(average, curve[-1].step, name="average")
+    start = curve[0]
+    if (point.select_success, point.select_return) < (start.select_success, start.select_return):
+        return curve[0], judge.first, []
+    return point, average, [step for step, _ in judge.tail]
+
 
 def plot_curve(
-    curve: list[EvalPoint], controller: EvalPoint, title: str, path: Path, kept: int | None = None
+    curve: list[EvalPoint],
+    controller: EvalPoint,
+    title: str,
+    path: Path,
+    kept: EvalPoint | None = None,
+    kept_label: str = "kept",
 ) -> None:
     """Evaluated success and return against env steps, with the start (the first point) and
     the controller on the same seeds as lines; the success on all the seeds the kept actor is
-    chosen on, where those are more, and the kept actor (step ``kept``) marked."""
+    chosen on, where those are more, and the kept actor (``kept``, on those seeds) marked."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -125,12 +190,14 @@ def plot_curve(
         scale = 100 if key == "success" else 1
         values = [scale * getattr(p, key) for p in curve]
         ax.plot(steps, values, marker="o", label=f"policy ({controller.chosen_on} seeds)")
-        chosen = [scale * getattr(p, chosen_key) for p in curve]
-        if curve[0].chosen_on > controller.chosen_on:
-            ax.plot(steps, chosen, marker=".", alpha=0.7, label=f"on {curve[0].chosen_on} seeds")
-        for p, v in zip(curve, chosen, strict=True):
-            if p.step == kept:  # where it was chosen
-                ax.plot([p.step], [v], marker="*", markersize=14, color="red", label="kept")
+        more = [p for p in curve if p.chosen_on > controller.chosen_on]
+        if len(more) > 1:
+            chosen = [scale * getattr(p, chosen_key) for p in more]
+            label = f"on {more[0].chosen_on} seeds"
+            ax.plot([p.step for p in more], chosen, marker=".", alpha=0.7, label=label)
+        if kept is not None:
+            mark = scale * getattr(kept, chosen_key)
+            ax.plot([kept.step], [mark], marker="*", markersize=14, color="red", label=kept_label)
         ax.axhline(values[0], color="grey", linestyle="--", label="start")
         expert = scale * getattr(controller, key)
         ax.axhline(expert, color="green", linestyle=":", label="controller")

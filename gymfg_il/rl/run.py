@@ -35,7 +35,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 from gymfg_il.errors import ConfigError
 from gymfg_il.rl.config import PPORunConfig
 from gymfg_il.rl.env import make_env
-from gymfg_il.rl.judge import EvalPoint, Judge, plot_curve
+from gymfg_il.rl.judge import EvalPoint, Judge, choose, plot_curve
 from gymfg_il.rl.policy import AnchoredPolicy
 from gymfg_il.rl.start import Start, as_ppo, meta_of, starting_policy, stats_of
 from gymfg_il.rl.vec import GroupedVecEnv, training_envs
@@ -52,7 +52,13 @@ class PPOResult:
     curve: list[EvalPoint]
     controller: EvalPoint
     notes: list[str]
-    kept_step: int  # the evaluation whose actor was saved (``PPORunConfig.keep``)
+    kept: EvalPoint  # the saved actor's evaluation (``PPORunConfig.keep``)
+    averaged: list[int]  # the steps whose actors were averaged into it (keep average)
+
+    @property
+    def kept_step(self) -> int:
+        """The step of the saved actor's evaluation (the average: the last step)."""
+        return self.kept.step
 
 
 def train_ppo(
@@ -93,7 +99,9 @@ def _train(
     # the evaluations' processes, started before the envs' (the env processes wait while an
     # evaluation flies)
     pool = Workers(min(2, len(os.sched_getaffinity(0)))) if more else Workers(1)
-    judge = Judge(flight, seeds, start, scratch_dir, began, more, pool, cfg.checkpoints)
+    judge = Judge(
+        flight, seeds, start, scratch_dir, began, more, pool, cfg.checkpoints, cfg.average_start
+    )
     try:
         controller = judge.controller()
         curve = [judge(module, 0)]
@@ -133,15 +141,14 @@ def _train(
         finally:
             venv.close()
         last = model.policy.actor  # after the last update, which no evaluation has seen
-        curve.append(judge(last, model.num_timesteps))
+        curve.append(judge(last, model.num_timesteps, more=cfg.keep == "best"))
         if on_eval:
             on_eval(curve[-1])
+        kept, actor, averaged = choose(cfg.keep, judge, curve, last)
         seconds = time.perf_counter() - began
-        assert judge.best is not None
-        step, actor = (
-            (judge.best[1], judge.best[2]) if cfg.keep == "best" else (curve[-1].step, last)
+        result = PPOResult(
+            out, model.num_timesteps, seconds, curve, controller, start.notes, kept, averaged
         )
-        result = PPOResult(out, model.num_timesteps, seconds, curve, controller, start.notes, step)
         _save(cfg, result, start, actor, scratch_dir)
         return result
     finally:
@@ -310,7 +317,7 @@ class _Watch(BaseCallback):
             self.next_eval += self.cfg.eval_every
         policy = self.model.policy
         assert isinstance(policy, AnchoredPolicy)
-        point = self.judge(policy.actor, self.num_timesteps)
+        point = self.judge(policy.actor, self.num_timesteps, more=self.cfg.keep == "best")
         self.curve.append(point)
         self.logger.record("eval/success", point.success)
         self.logger.record("eval/mean_return", point.mean_return)
@@ -341,7 +348,9 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, scratc
         "kept": {
             "which": cfg.keep,
             "step": result.kept_step,
-            "chosen_on": result.curve[-1].chosen_on,
+            "chosen_on": result.kept.chosen_on,
+            "averaged": result.averaged,
+            "select_success": result.kept.select_success,
         },
         "wall_s": round(result.seconds, 1),
         "envs": cfg.n_envs,
@@ -366,8 +375,9 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, scratc
             )
             (folder / "curve.json").write_text(json.dumps(rl, indent=1))
             title = f"{name}: {flight.task_label} on {flight.aircraft}"
+            label = f"kept: mean of {len(result.averaged)}" if result.averaged else "kept"
             plot_curve(
-                result.curve, result.controller, title, folder / "curve.png", result.kept_step
+                result.curve, result.controller, title, folder / "curve.png", result.kept, label
             )
             for part in ("tensorboard", "checkpoints"):
                 if (scratch / part).is_dir():

@@ -92,7 +92,8 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     # the best evaluation's actor is kept (the start's, where nothing beat it), chosen on the
     # curve's two seeds and the next two: the start's point is the BC policy's on each
     best = max(result.curve, key=lambda p: (p.select_success, p.select_return))
-    assert config["rl"]["kept"] == {"which": "best", "step": best.step, "chosen_on": 4}
+    kept_entry = {"which": "best", "step": best.step, "chosen_on": 4, "averaged": []}
+    assert config["rl"]["kept"] == {**kept_entry, "select_success": best.select_success}
     flight = FlightSpec.from_dict(config["spec"])  # the run's: in light turbulence
     for seeds, success, mean_return in (
         ([7000, 7001], result.curve[0].success, result.curve[0].mean_return),
@@ -141,6 +142,45 @@ def test_a_seeded_run_repeats(bc_policy, tmp_path):
     assert all(torch.equal(runs[0][k], runs[1][k]) for k in runs[0])
     assert not all(torch.equal(runs[0][k], runs[2][k]) for k in runs[0])  # the seed matters
     assert not all(torch.equal(runs[0][k], start[k]) for k in start)  # the actor learnt
+
+
+def test_the_kept_actor_can_be_the_mean_of_the_late_actors(bc_policy, tmp_path):
+    from safetensors.torch import load_file
+
+    from gymfg_il.evaluation.runner import evaluate
+    from gymfg_il.rl.run import train_ppo
+    from gymfg_il.rollout.agents import AgentSpec
+
+    out = tmp_path / "ppo"
+    changes = dict(steps=3072, eval_every=1024, keep="average", average_from=0.3)
+    result = train_ppo(_short(bc_policy, out, checkpoints=True, **changes))
+    steps = [p.step for p in result.curve]
+    assert steps == [0, 1024, 2048, 3072]
+    # only the start and the average fly the selection seeds; the others the curve's two
+    assert [p.chosen_on for p in result.curve] == [4, 2, 2, 2]
+    kept = json.loads((out / "config.json").read_text())["rl"]["kept"]
+    assert kept["which"] == "average" and kept["averaged"] == [1024, 2048, 3072]
+    saved = load_file(str(out / "model.safetensors"))
+    parts = [load_file(str(out / "checkpoints" / f"step-{s}" / "model.safetensors")) for s in steps]
+    for k, v in saved.items():  # the mean of the three late actors, not of the start's
+        late = np.mean([p[k].double().numpy() for p in parts[1:]], axis=0)
+        np.testing.assert_allclose(v.numpy(), late, rtol=1e-6, atol=1e-7)
+    assert not np.allclose(saved["net.2.weight"], parts[-1]["net.2.weight"])  # no one actor
+    for k in ("obs_norm.mean", "obs_norm.std", "action_norm.std"):
+        assert torch.equal(saved[k], parts[0][k])  # the same in all: exactly as they were
+    # its figure is what eval gives it on the four selection seeds, and beats the start's
+    rows, _ = evaluate(_flight(bc_policy), {"avg": AgentSpec.policy(out)}, [7000, 7001, 7002, 7003])
+    assert rows[0]["success_rate"] == kept["select_success"] == result.kept.select_success
+    first, avg = result.curve[0], result.kept
+    assert (avg.select_success, avg.select_return) >= (first.select_success, first.select_return)
+    # an actor taught at a rate that wrecks it: the average flies worse, the start is kept
+    wrecked = train_ppo(_short(bc_policy, tmp_path / "w", **{**changes, "actor_lr": 0.05}))
+    assert wrecked.averaged == [] and wrecked.kept is wrecked.curve[0]
+    start = load_file(str(bc_policy / "model.safetensors"))
+    saved = load_file(str(tmp_path / "w" / "model.safetensors"))
+    assert all(torch.equal(saved[k], start[k]) for k in start)
+    with pytest.raises(ConfigError, match=r"average_from=1\.0 must lie in \[0, 1\)"):
+        PPORunConfig(init=bc_policy, keep="average", average_from=1.0)
 
 
 def _flight(bc_policy):
