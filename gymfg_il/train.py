@@ -97,12 +97,9 @@ def _ppo(args: argparse.Namespace) -> int:
         print(note, file=sys.stderr)
     flight = start.flight
     kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
-    keep = {
-        "best": f"the kept actor the best on {kept_on}",
-        "last": "the last kept",
-        "average": f"the kept actor the mean of those from step {cfg.average_start:,} on, "
-        f"flown on {kept_on}",
-    }[cfg.keep]
+    keep = f"the kept actor the best on {kept_on}" if cfg.keep == "best" else "the last kept"
+    if cfg.average_start is not None:
+        keep = f"the kept actor the mean of those from step {cfg.average_start:,} on ({kept_on})"
     print(
         f"PPO on {flight.task_label} on {flight.aircraft} ({flight.turbulence} turbulence): "
         f"{cfg.steps:,} env steps on {cfg.n_envs} env(s), evaluated every {cfg.eval_every:,} "

@@ -26,6 +26,16 @@ def bc_policy(tiny_dataset, tmp_path_factory):
     return out
 
 
+def _argv(bc_policy, out, *more):
+    """``train ppo``'s command line for ``_short``'s run."""
+    return [
+        "ppo", "--init", str(bc_policy), "--out", str(out), "--steps", "1024", "--envs", "2",
+        "--rollout-steps", "256", "--batch-size", "128", "--epochs", "2", "--eval-every", "1024",
+        "--eval-episodes", "2", "--select-episodes", "4", "--critic-warmup", "256", "--seed", "3",
+        "--no-progress", *more,
+    ]  # fmt: skip
+
+
 def _short(bc_policy, out, **changes):
     settings = dict(
         init=bc_policy, out=out, steps=1024, envs=2, rollout_steps=256, batch_size=128,
@@ -75,14 +85,16 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     from gymfg_il.envs.flight import FlightSpec
     from gymfg_il.evaluation.config import EvalConfig
     from gymfg_il.evaluation.runner import evaluate, run_eval
-    from gymfg_il.rl.run import train_ppo
+    from gymfg_il.rl.judge import EvalPoint
     from gymfg_il.rollout.agents import AgentSpec
+    from gymfg_il.train import main
 
     out = tmp_path / "ppo"
-    result = train_ppo(_short(bc_policy, out, turbulence="light", checkpoints=True))
-    assert result.steps >= 1024
-    assert [p.step for p in result.curve] == [0, 1024]
+    assert main(_argv(bc_policy, out, "--turbulence", "light", "--checkpoints")) == 0
     config = json.loads((out / "config.json").read_text())
+    curve = [EvalPoint(**p) for p in config["rl"]["curve"]]
+    assert config["rl"]["steps"] >= 1024
+    assert [p.step for p in curve] == [0, 1024]
     assert config["type"] == "ppo" and config["policy"]["hidden"] == [256, 256]
     assert config["spec"]["turbulence"] == "light"
     assert config["rl"]["init"] == str(bc_policy) and config["train"]  # DAgger retrains on it
@@ -91,13 +103,13 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     assert list((out / "tensorboard").rglob("events.out.tfevents.*"))
     # the best evaluation's actor is kept (the start's, where nothing beat it), chosen on the
     # curve's two seeds and the next two: the start's point is the BC policy's on each
-    best = max(result.curve, key=lambda p: (p.select_success, p.select_return))
+    best = max(curve, key=lambda p: (p.select_success, p.select_return))
     kept_entry = {"which": "best", "step": best.step, "chosen_on": 4, "averaged": []}
     assert config["rl"]["kept"] == {**kept_entry, "select_success": best.select_success}
     flight = FlightSpec.from_dict(config["spec"])  # the run's: in light turbulence
     for seeds, success, mean_return in (
-        ([7000, 7001], result.curve[0].success, result.curve[0].mean_return),
-        ([7000, 7001, 7002, 7003], result.curve[0].select_success, result.curve[0].select_return),
+        ([7000, 7001], curve[0].success, curve[0].mean_return),
+        ([7000, 7001, 7002, 7003], curve[0].select_success, curve[0].select_return),
     ):
         rows, _ = evaluate(flight, {"bc": AgentSpec.policy(bc_policy)}, seeds)
         assert (rows[0]["success_rate"], rows[0]["mean_return"]) == (success, mean_return)
@@ -108,7 +120,7 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     assert same == (best.step == 0)
     # every evaluated actor kept, as asked: the kept one among them, the start as it was
     steps = sorted(int(p.name.split("-")[1]) for p in (out / "checkpoints").iterdir())
-    assert steps == [p.step for p in result.curve]
+    assert steps == [p.step for p in curve]
     for step, want in ((best.step, kept), (0, start)):
         saved = load_file(str(out / "checkpoints" / f"step-{step}" / "model.safetensors"))
         assert all(torch.equal(saved[k], want[k]) for k in want)
@@ -144,12 +156,13 @@ def test_a_seeded_run_repeats(bc_policy, tmp_path):
     assert not all(torch.equal(runs[0][k], start[k]) for k in start)  # the actor learnt
 
 
-def test_the_kept_actor_can_be_the_mean_of_the_late_actors(bc_policy, tmp_path):
+def test_the_kept_actor_can_be_the_mean_of_the_late_actors(bc_policy, tmp_path, capsys):
     from safetensors.torch import load_file
 
     from gymfg_il.evaluation.runner import evaluate
     from gymfg_il.rl.run import train_ppo
     from gymfg_il.rollout.agents import AgentSpec
+    from gymfg_il.train import main
 
     out = tmp_path / "ppo"
     changes = dict(steps=3072, eval_every=1024, keep="average", average_from=0.3)
@@ -174,8 +187,12 @@ def test_the_kept_actor_can_be_the_mean_of_the_late_actors(bc_policy, tmp_path):
     first, avg = result.curve[0], result.kept
     assert (avg.select_success, avg.select_return) >= (first.select_success, first.select_return)
     # an actor taught at a rate that wrecks it: the average flies worse, the start is kept
-    wrecked = train_ppo(_short(bc_policy, tmp_path / "w", **{**changes, "actor_lr": 0.05}))
-    assert wrecked.averaged == [] and wrecked.kept is wrecked.curve[0]
+    # (through the command line, as a user runs it)
+    more = ["--keep", "average", "--average-from", "0.3", "--actor-lr", "0.05"]
+    assert main([*_argv(bc_policy, tmp_path / "w", *more), "--steps", "3072"]) == 0
+    printed = capsys.readouterr()
+    assert "the mean of those from step 921 on (7000..7003)" in printed.err
+    assert "the actor of the start (the average flew worse on these seeds)" in printed.out
     start = load_file(str(bc_policy / "model.safetensors"))
     saved = load_file(str(tmp_path / "w" / "model.safetensors"))
     assert all(torch.equal(saved[k], start[k]) for k in start)
