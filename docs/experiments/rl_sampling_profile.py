@@ -1,9 +1,11 @@
 """One env process's share of ``train ppo``'s sampling, in this process: ``N`` c172p altitude
 envs (10 Hz) sampled by the numpy policy (``rl.sampling.sample_rollout``, a fresh MLP), beside
 a bare JSBSim loop of the same agent steps (``benchmarks.physics.raw_loop``), three rounds;
-with ``--profile``, cProfile's top functions of one more rollout.
+with ``--profile``, cProfile's top functions of one more rollout; with ``--parts``, the time
+of each part of the loop's step (the actor's pass, the clip, the envs' steps, the rest),
+measured inside the loop, and the same loop with a fixed action in place of the actor.
 
-    PYTHONPATH=. python docs/experiments/rl_sampling_profile.py [--envs 4] [--profile]
+    PYTHONPATH=. python docs/experiments/rl_sampling_profile.py [--envs 4] [--profile] [--parts]
 
 The results: docs/results/rl.md, Speed.
 """
@@ -17,6 +19,7 @@ import tempfile
 import time
 from functools import partial
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
@@ -28,15 +31,45 @@ from gymfg_il.policies.modeling_mlp import MLPPolicy
 from gymfg_il.rl.config import PPORunConfig
 from gymfg_il.rl.env import make_env
 from gymfg_il.rl.run import make_model
-from gymfg_il.rl.sampling import install, sample_rollout, sampling_copy
+from gymfg_il.rl.sampling import install, sample_rollout, sampling_copy, step_env
 
 STEPS = 2000  # steps of each env a round
+
+
+def parts(policy: Any, envs: list[Any], obs: np.ndarray, steps: int, actor: bool) -> str:
+    """µs an env step of each part of ``sample_rollout``'s step, timed inside the loop
+    (``actor`` False: a fixed action, no network)."""
+    space = envs[0].action_space
+    fixed = np.zeros((len(envs), 4), dtype=np.float32)
+    fixed[:, 3] = 0.75
+    spent = dict.fromkeys(("actor", "clip", "envs", "rest"), 0.0)
+    policy.reset_noise(len(envs))
+    for t in range(steps):
+        a = time.perf_counter()
+        if t % 4 == 0:
+            policy.reset_noise(len(envs))
+        action = policy.sample(obs)[0] if actor else fixed
+        b = time.perf_counter()
+        clipped = np.clip(action, space.low, space.high)
+        c = time.perf_counter()
+        out = [step_env(env, x) for env, x in zip(envs, clipped, strict=True)]
+        d = time.perf_counter()
+        np.array([o[1] for o in out]), np.array([o[2] for o in out])
+        obs = np.stack([o[0] for o in out])
+        spent["rest"] += time.perf_counter() - d
+        spent["actor"] += b - a
+        spent["clip"] += c - b
+        spent["envs"] += d - c
+    each = {k: v / (steps * len(envs)) * 1e6 for k, v in spent.items()}
+    shown = ", ".join(f"{k} {v:.1f}" for k, v in each.items())
+    return f"{'actor' if actor else 'fixed action'}: {shown}; all {sum(each.values()):.1f} µs"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--envs", type=int, default=4, help="envs in the process")
     parser.add_argument("--profile", action="store_true", help="print cProfile's top 30")
+    parser.add_argument("--parts", action="store_true", help="time each part of a step")
     args = parser.parse_args()
     flight = FlightSpec.solo("c172p", "altitude")
     probe = flight.make_env()
@@ -65,6 +98,9 @@ def main() -> None:
             f"round {r}: sampling {sampled * 1e6:.1f} µs an env step, bare JSBSim "
             f"{bare * 1e6:.1f} µs a step, ratio {bare / sampled:.2f}"
         )
+    if args.parts:
+        for actor in (True, False, True, False):
+            print(parts(policy, envs, obs, STEPS, actor))
     if args.profile:
         profile = cProfile.Profile()
         profile.enable()

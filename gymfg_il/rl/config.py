@@ -67,7 +67,8 @@ class PPORunConfig:
         average_from: with --keep average, the share of the run from which the evaluated
             actors are averaged (0.5: those of its second half).
         checkpoints: keep every evaluated actor, a policy in OUT/checkpoints/step-N (about
-            0.6 MB each), to fly again (``eval --policy``) or choose on other seeds.
+            0.6 MB each; with --keep average the mean too, in OUT/checkpoints/average), to
+            fly again (``eval --policy``) or choose on other seeds.
         rollout_steps: steps each env samples between updates (PPO's n_steps).
         batch_size: samples per gradient step.
         epochs: passes over each rollout per update.

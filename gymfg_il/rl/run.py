@@ -375,7 +375,8 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, scratc
             )
             (folder / "curve.json").write_text(json.dumps(rl, indent=1))
             title = f"{name}: {flight.task_label} on {flight.aircraft}"
-            label = f"kept: mean of {len(result.averaged)}" if result.averaged else "kept"
+            n = len(result.averaged)
+            label = f"kept: mean of {n} ({result.kept.chosen_on} seeds)" if n else "kept"
             plot_curve(
                 result.curve, result.controller, title, folder / "curve.png", result.kept, label
             )

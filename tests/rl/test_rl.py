@@ -179,6 +179,8 @@ def test_the_kept_actor_can_be_the_mean_of_the_late_actors(bc_policy, tmp_path, 
         late = np.mean([p[k].double().numpy() for p in parts[1:]], axis=0)
         np.testing.assert_allclose(v.numpy(), late, rtol=1e-6, atol=1e-7)
     assert not np.allclose(saved["net.2.weight"], parts[-1]["net.2.weight"])  # no one actor
+    kept_too = load_file(str(out / "checkpoints" / "average" / "model.safetensors"))
+    assert all(torch.equal(kept_too[k], saved[k]) for k in saved)  # kept with the others
     for k in ("obs_norm.mean", "obs_norm.std", "action_norm.std"):
         assert torch.equal(saved[k], parts[0][k])  # the same in all: exactly as they were
     # its figure is what eval gives it on the four selection seeds, and beats the start's
