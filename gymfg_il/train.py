@@ -130,7 +130,7 @@ def _ppo(args: argparse.Namespace) -> int:
         which = f"the mean of the {len(averaged)} actors of steps {averaged[0]:,}..{averaged[-1]:,}"
     else:
         which = "the actor of " + ("the start" if kept.step == 0 else f"step {kept.step:,}")
-        if cfg.keep == "average":  # the average succeeded less than the start
+        if cfg.keep == "average":  # the start flew better than the average
             which += " (the average flew worse on these seeds)"
     print(
         f"policy saved to {result.out}: {which} ({100 * kept.select_success:.0f}% success on "

@@ -24,12 +24,12 @@ import shutil
 import tempfile
 from pathlib import Path
 
-import torch
 from safetensors.torch import load_file, save_file
 
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.evaluation.metrics import score_episode
 from gymfg_il.evaluation.runner import evaluate
+from gymfg_il.rl.judge import mean_weights
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.workers import Workers
 
@@ -37,16 +37,12 @@ BLOCKS = (9300, 9400, 9500)
 
 
 def averaged(run: Path, steps: list[int], folder: Path) -> Path:
-    """A policy in ``folder`` whose weights are the mean (in float64) of the checkpoints of
-    ``steps``, as ``train ppo --keep average`` computes it."""
+    """A policy in ``folder`` whose weights are the mean of the checkpoints of ``steps``, as
+    ``train ppo --keep average`` computes it (``rl.judge.mean_weights``)."""
     parts = [load_file(str(run / "checkpoints" / f"step-{s}" / "model.safetensors")) for s in steps]
-    mean = {
-        k: torch.stack([p[k].double() for p in parts]).mean(0).to(v.dtype)
-        for k, v in parts[-1].items()
-    }
     folder.mkdir(parents=True)
     shutil.copy(run / "checkpoints" / f"step-{steps[-1]}" / "config.json", folder / "config.json")
-    save_file(mean, str(folder / "model.safetensors"))
+    save_file(mean_weights(parts), str(folder / "model.safetensors"))
     return folder
 
 

@@ -7,9 +7,9 @@ The curve is the first ``eval_episodes`` seeds' success; the kept actor is chose
 about 10 points, as wide as the actors' differences, and the best of twenty such draws is
 mostly the luckiest (docs/results/rl.md, "Choosing the kept actor on more episodes"). Or the
 kept actor is the mean of the weights of the actors evaluated in the run's late part
-(``Judge.average``): one actor's luck on a few episodes no longer picks it, and the average
-flew better held out than the actor chosen on 64 episodes (docs/results/rl.md, "Averaging the
-late actors")."""
+(``Judge.average``, ``--keep average``): one actor's luck on a few episodes no longer picks
+it; steadier on the altitude by success, but it crashed more (docs/results/rl.md, "Averaging
+the late actors")."""
 
 from __future__ import annotations
 
@@ -100,8 +100,7 @@ class Judge:
         from gymfg_il.policies.checkpoint import save_policy
         from gymfg_il.rollout.agents import AgentSpec
 
-        name = name or f"step-{step}"
-        path = self.folder / ("checkpoints" if self.keep_all else "") / name
+        path = self.folder / ("checkpoints" if self.keep_all else "") / (name or f"step-{step}")
         module = as_ppo(actor)
         meta = {**meta_of(self.start), "name": path.name, "spec": self.flight.to_dict()}
         save_policy(
@@ -110,7 +109,7 @@ class Judge:
         point = self._fly(step, AgentSpec.policy(path), more)
         if not self.keep_all:
             shutil.rmtree(path, ignore_errors=True)
-        if name != f"step-{step}":
+        if name:
             return point
         if self.first is None:
             self.first = module
@@ -124,24 +123,27 @@ class Judge:
 
     def average(self) -> Any:
         """The start's network with the mean of the weights of the actors evaluated from
-        ``average_from`` on (computed in float64: the normalisations, the same in all, stay
-        exactly as they are)."""
+        ``average_from`` on (``mean_weights``)."""
         import copy
-
-        import torch
 
         if not self.tail or self.first is None:
             raise RuntimeError("no evaluated actor to average: evaluate some first")
         module = copy.deepcopy(self.first)
-        parts = [weights for _, weights in self.tail]
-        mean = {
-            k: torch.stack([w[k].double() for w in parts]).mean(0).to(v.dtype)
-            if v.is_floating_point()
-            else v
-            for k, v in parts[-1].items()
-        }
-        module.load_state_dict(mean)
+        module.load_state_dict(mean_weights([weights for _, weights in self.tail]))
         return module
+
+
+def mean_weights(parts: list[dict[str, Any]]) -> dict[str, Any]:
+    """The mean of several state dicts of one network (torch tensors), in float64 and cast
+    back, so that what is the same in all (the normalisations) stays exactly as it is."""
+    import torch
+
+    return {
+        k: torch.stack([w[k].double() for w in parts]).mean(0).to(v.dtype)
+        if v.is_floating_point()
+        else v
+        for k, v in parts[-1].items()
+    }
 
 
 def choose(keep: str, judge: Judge, curve: list[EvalPoint], last: Any) -> tuple[Any, ...]:
