@@ -2,7 +2,9 @@
 included) from N envs in one process per core, each sampling its envs' actions itself
 (``rl.vec``, as ``train ppo`` runs them, the policy as numpy functions: ``rl.forward``),
 against the physics it cannot beat: min(N, cores) bare JSBSim loops doing the same agent
-steps (c172p altitude, 10 Hz = 12 JSBSim frames).
+steps (c172p altitude, 10 Hz = 12 JSBSim frames). Beside it, in the same rounds, the ceiling
+any sampler has here: the same training envs in as many processes, stepped by the same loop
+with a fixed action, no policy at all (``rl_envs_alone_vs_physics_bound``, reported).
 
     python -m benchmarks.rl [--envs 2 8 16]
 """
@@ -14,6 +16,7 @@ import os
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from benchmarks.common import Row, print_rows
 from benchmarks.physics import raw_loop
@@ -60,9 +63,73 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     return collect, venv.close
 
 
-def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> Row:
-    """Paired rounds: PPO sampling with ``n_envs`` envs, and one bare JSBSim loop (times
-    min(n_envs, cores): the bound with every core on physics)."""
+def _stepper(remote: Any, env_fn: Callable[[], Any], n: int, first_seed: int) -> None:
+    """An env process with no policy: ``n`` envs from ``env_fn`` stepped by
+    ``rl.sampling``'s loop (actions clipped to the box, each finished env reset) with a fixed
+    action, ``k`` steps each time it is sent ``k``; None ends it."""
+    import numpy as np
+
+    from gymfg_il.rl.sampling import step_env
+
+    envs = [env_fn() for _ in range(n)]
+    obs = np.stack([env.reset(seed=first_seed + i)[0] for i, env in enumerate(envs)])
+    space = envs[0].action_space
+    action = np.array([[0.0, 0.0, 0.0, 0.75]] * n, np.float32)
+    while (steps := remote.recv()) is not None:
+        for _ in range(steps):
+            clipped = np.clip(action, space.low, space.high)
+            out = [step_env(env, a) for env, a in zip(envs, clipped, strict=True)]
+            np.array([o[1] for o in out]), np.array([o[2] for o in out])
+            obs = np.stack([o[0] for o in out])
+        remote.send(len(obs))
+    for env in envs:
+        env.close()
+
+
+def envs_alone(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
+    """(step about ``steps`` env steps with no policy, close): ``n_envs`` training envs (as
+    ``sampler``'s) in one process per core, grouped as ``train ppo`` groups them."""
+    import multiprocessing as mp
+    from functools import partial
+
+    from gymfg_il.envs.flight import FlightSpec
+    from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.vec import groups_of
+
+    flight = FlightSpec.solo("c172p", "altitude")
+    env_fn = partial(make_env, flight.to_dict(), [0.0] * 4, [1.0] * 4, 0.2)
+    ctx: Any = mp.get_context("forkserver")
+    groups = groups_of(n_envs, len(os.sched_getaffinity(0)))
+    remotes, processes = [], []
+    for group in groups:
+        remote, work = ctx.Pipe()
+        process = ctx.Process(
+            target=_stepper, args=(work, env_fn, len(group), group.start), daemon=True
+        )
+        process.start()
+        remotes.append(remote)
+        processes.append(process)
+
+    def step(steps: int) -> None:
+        for remote in remotes:
+            remote.send(max(1, steps // n_envs))
+        for remote in remotes:
+            remote.recv()
+
+    def close() -> None:
+        for remote in remotes:
+            remote.send(None)
+        for process in processes:
+            process.join(timeout=10)
+
+    return step, close
+
+
+def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> list[Row]:
+    """Rounds of three, the order turning: PPO sampling with ``n_envs`` envs, the same envs
+    with no policy (``envs_alone``), and one bare JSBSim loop (times min(n_envs, cores): the
+    bound with every core on physics). Two rows: the sampling and the envs alone, over the
+    bound."""
     import statistics
 
     import torch
@@ -71,45 +138,58 @@ def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> Row:
     threads = torch.get_num_threads()
     torch.set_num_threads(1)  # as train ppo runs it
     collect, close = sampler(n_envs)
+    alone, close_alone = envs_alone(n_envs)
     raw = raw_loop()
     collect(steps // 4)  # the workers warm
-    ratios, rl, physics = [], [], []
+    alone(steps // 4)
+    ratios: dict[Callable[[int], None], list[float]] = {collect: [], alone: []}
+    rates: dict[Callable[[int], None], list[float]] = {collect: [], alone: [], raw: []}
     try:
         for i in range(rounds):
-            order = (collect, raw) if i % 2 == 0 else (raw, collect)
-            rates = {}
+            order = (collect, alone, raw)[i % 3 :] + (collect, alone, raw)[: i % 3]
             for fn in order:
-                n = steps if fn is collect else steps // 2
+                n = steps // 2 if fn is raw else steps
                 t0 = time.perf_counter()
                 fn(n)
-                rates[fn] = n / (time.perf_counter() - t0)
-            bound = rates[raw] * min(n_envs, cores)
-            rl.append(rates[collect])
-            physics.append(bound)
-            ratios.append(rates[collect] / bound)
+                rates[fn].append(n / (time.perf_counter() - t0))
+            bound = rates[raw][-1] * min(n_envs, cores)
+            for fn in (collect, alone):
+                ratios[fn].append(rates[fn][-1] / bound)
     finally:
         close()
+        close_alone()
         torch.set_num_threads(threads)
-    own = n_envs == cores  # the row by its name: as many envs as cores
-    return Row(
-        "rl_sampling_vs_physics_bound" + ("" if own else f"_{n_envs}_envs"),
-        statistics.median(ratios),
-        "ratio",
-        0.8,
-        detail=[
-            f"PPO sampling, {n_envs} envs            {statistics.median(rl):9,.0f} steps/s",
-            f"bound: {min(n_envs, cores)} x bare JSBSim      "
-            f"{statistics.median(physics):9,.0f} steps/s",
-        ],
-        extra={"rounds": ratios, "envs": n_envs, "cores": cores},
-    )
+    own = "" if n_envs == cores else f"_{n_envs}_envs"  # the row by its name: envs = cores
+    bound = statistics.median(rates[raw]) * min(n_envs, cores)
+    detail = [
+        f"PPO sampling, {n_envs} envs            {statistics.median(rates[collect]):9,.0f} steps/s",
+        f"the envs alone, no policy   {statistics.median(rates[alone]):9,.0f} steps/s",
+        f"bound: {min(n_envs, cores)} x bare JSBSim      {bound:9,.0f} steps/s",
+    ]
+    extra = {"envs": n_envs, "cores": cores}
+    return [
+        Row(
+            "rl_sampling_vs_physics_bound" + own,
+            statistics.median(ratios[collect]),
+            "ratio",
+            0.8,
+            detail=detail,
+            extra={"rounds": ratios[collect], **extra},
+        ),
+        Row(
+            "rl_envs_alone_vs_physics_bound" + own,
+            statistics.median(ratios[alone]),
+            "ratio",
+            extra={"rounds": ratios[alone], **extra},
+        ),
+    ]
 
 
 def rows(quick: bool, envs: tuple[int, ...] | None = None) -> list[Row]:
     cores = len(os.sched_getaffinity(0))
     chosen = envs or ((cores,) if quick else (cores, 4 * cores))
-    steps, rounds = (1024, 2) if quick else (8192, 5)
-    return [sampling_vs_bound(n, steps, rounds) for n in chosen]
+    steps, rounds = (1024, 3) if quick else (8192, 6)
+    return [row for n in chosen for row in sampling_vs_bound(n, steps, rounds)]
 
 
 def main(argv: list[str] | None = None) -> int:

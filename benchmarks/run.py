@@ -10,8 +10,8 @@ camera_frames_per_s (``camera``),
 manual_loop_p99_period_error_ms, synthetic_pilot_x_realtime and
 input_to_record_p99_steps (``manual``),
 online_{2,8,16}_teams_steps_per_s and online_2_teams_pinned_steps_per_s (``online``),
-rl_sampling_vs_physics_bound with cores and 4 x cores envs (``rl``). Ratios
-are medians of paired rounds (see ``benchmarks.common``).
+rl_sampling_vs_physics_bound and rl_envs_alone_vs_physics_bound (its ceiling) with cores
+and 4 x cores envs (``rl``). Ratios are medians of paired rounds (see ``benchmarks.common``).
 """
 
 from __future__ import annotations

@@ -23,3 +23,24 @@ def test_the_online_benchmark_keeps_the_clients_waits_to_itself():
     assert done.returncode == 0, done.stderr[-2000:]
     assert float(done.stdout.strip()) > 0  # steps/s, and nothing else
     assert "waiting for" not in done.stderr, done.stderr
+
+
+def test_the_rl_benchmark_prints_the_sampling_beside_its_ceiling():
+    done = subprocess.run(
+        [sys.executable, "-m", "benchmarks.rl", "--quick", "--envs", "2"],
+        cwd=ROOT,
+        env={**os.environ, "HF_HUB_OFFLINE": "1"},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    ratios = {
+        line.split()[0]: float(line.split()[1])
+        for line in done.stdout.splitlines()
+        if line.startswith("rl_")
+    }
+    sampling = ratios["rl_sampling_vs_physics_bound"]
+    alone = ratios["rl_envs_alone_vs_physics_bound"]
+    # the same envs with no policy to run are the ceiling of any sampler
+    assert 0 < sampling < alone, done.stdout
