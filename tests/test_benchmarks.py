@@ -10,30 +10,28 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.mark.network
-def test_the_online_benchmark_keeps_the_clients_waits_to_itself():
-    done = subprocess.run(
-        [sys.executable, "-m", "benchmarks.online", "--rate", "4", "20"],
-        cwd=ROOT,
-        env={**os.environ, "HF_HUB_OFFLINE": "1"},
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert float(done.stdout.strip()) > 0  # steps/s, and nothing else
-    assert "waiting for" not in done.stderr, done.stderr
-
-
-def test_the_rl_benchmark_prints_the_sampling_beside_its_ceiling():
-    done = subprocess.run(
-        [sys.executable, "-m", "benchmarks.rl", "--quick", "--envs", "2"],
+def _benchmark(name: str, *args: str) -> subprocess.CompletedProcess[str]:
+    """``python -m benchmarks.NAME ARGS`` from the repository's root, its output captured."""
+    return subprocess.run(
+        [sys.executable, "-m", f"benchmarks.{name}", *args],
         cwd=ROOT,
         env={**os.environ, "HF_HUB_OFFLINE": "1"},
         capture_output=True,
         text=True,
         timeout=600,
     )
+
+
+@pytest.mark.network
+def test_the_online_benchmark_keeps_the_clients_waits_to_itself():
+    done = _benchmark("online", "--rate", "4", "20")
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert float(done.stdout.strip()) > 0  # steps/s, and nothing else
+    assert "waiting for" not in done.stderr, done.stderr
+
+
+def test_the_rl_benchmark_prints_the_sampling_beside_its_ceiling():
+    done = _benchmark("rl", "--quick", "--envs", "2")
     assert done.returncode == 0, done.stderr[-2000:]
     ratios = {
         line.split()[0]: float(line.split()[1])
