@@ -43,7 +43,9 @@ class PPORunConfig:
         seed: seeds the envs (env k starts from seed + k), the sampling and the networks; a
             run with the same settings and the same number of envs repeats exactly on the
             same machine and install (give --envs to repeat a run on a machine with other
-            cores; on another machine a long run may part from it, docs/results/rl.md).
+            cores; on another machine a long run may part from it, docs/results/rl.md). Env
+            k draws all its episodes from seed + k, so runs meant to be independent take
+            seeds at least envs apart (seeds 3 and 4 share 7 of 8 envs' episodes).
         eval_every: evaluate the policy's mean action every this many env steps.
         eval_episodes: held-out episodes each evaluation flies (seeds eval_seed, eval_seed +
             1, ...), the same every time, with the controller on them once.
