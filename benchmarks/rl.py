@@ -3,8 +3,9 @@ included) from N envs in one process per core, each sampling its envs' actions i
 (``rl.vec``, as ``train ppo`` runs them, the policy as numpy functions: ``rl.forward``),
 against the physics it cannot beat: min(N, cores) bare JSBSim loops doing the same agent
 steps (c172p altitude, 10 Hz = 12 JSBSim frames). Beside it, in the same rounds, the ceiling
-any sampler has here: the same training envs in as many processes, stepped by the same loop
-with a fixed action, no policy at all (``rl_envs_alone_vs_physics_bound``, reported).
+any sampler has here: the same training envs in as many processes, sampled by the same loop
+(``rl.sampling.sample_rollout``) with a fixed action, no policy at all
+(``rl_envs_alone_vs_physics_bound``, reported).
 
     python -m benchmarks.rl [--envs 2 8 16]
 """
@@ -63,24 +64,46 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     return collect, venv.close
 
 
+class _FixedActions:
+    """``rl.sampling.sample_rollout``'s policy with no network: the same action for every env
+    at every step, values and log-probabilities 0."""
+
+    action = (0.0, 0.0, 0.0, 0.75)
+
+    def load(self, weights: Any) -> None:
+        pass
+
+    def reset_noise(self, n: int) -> None:
+        pass
+
+    def sample(self, obs: Any) -> tuple[Any, Any]:
+        import numpy as np
+
+        actions = np.tile(np.array(self.action, np.float32), (len(obs), 1))
+        return actions, actions
+
+    def values(self, obs: Any) -> Any:
+        import numpy as np
+
+        return np.zeros(len(obs), np.float32)
+
+    def score(self, obs: Any, actions: Any, mu: Any) -> tuple[Any, Any]:
+        return self.values(obs), self.values(obs)
+
+
 def _stepper(remote: Any, env_fn: Callable[[], Any], n: int, first_seed: int) -> None:
-    """An env process with no policy: ``n`` envs from ``env_fn`` stepped by
-    ``rl.sampling``'s loop (actions clipped to the box, each finished env reset) with a fixed
+    """An env process with no policy: ``n`` envs from ``env_fn`` sampled by
+    ``rl.sampling.sample_rollout`` (the loop ``train ppo``'s env processes run) with a fixed
     action, ``k`` steps each time it is sent ``k``; None ends it."""
     import numpy as np
 
-    from gymfg_il.rl.sampling import step_env
+    from gymfg_il.rl.sampling import sample_rollout
 
     envs = [env_fn() for _ in range(n)]
     obs = np.stack([env.reset(seed=first_seed + i)[0] for i, env in enumerate(envs)])
-    space = envs[0].action_space
-    action = np.array([[0.0, 0.0, 0.0, 0.75]] * n, np.float32)
+    fixed = _FixedActions()
     while (steps := remote.recv()) is not None:
-        for _ in range(steps):
-            clipped = np.clip(action, space.low, space.high)
-            out = [step_env(env, a) for env, a in zip(envs, clipped, strict=True)]
-            np.array([o[1] for o in out]), np.array([o[2] for o in out])
-            obs = np.stack([o[0] for o in out])
+        obs = sample_rollout(fixed, envs, obs, None, steps, -1)["last_obs"]  # type: ignore[arg-type]
         remote.send(len(obs))
     for env in envs:
         env.close()
