@@ -21,7 +21,6 @@ import numpy as np
 
 from gymfg_il.controllers import gains as gains_module
 from gymfg_il.envs.options import FlightOptions
-from gymfg_il.evaluation.metrics import score_episode
 from gymfg_il.evaluation.runner import evaluate
 from gymfg_il.rollout.agents import AgentSpec
 
@@ -55,10 +54,9 @@ def main() -> None:
             rates, errors = [], []
             for block in BLOCKS:
                 seeds = list(range(block, block + args.episodes))
-                _, traces = evaluate(flight, {"controller": AgentSpec.controller()}, seeds)
-                scores = [score_episode(t) for t in traces["controller"]]
-                rates.append(np.mean([s.success for s in scores]))
-                errors += [s.steady_state_error for s in scores]
+                (row,), _ = evaluate(flight, {"controller": AgentSpec.controller()}, seeds)
+                rates.append(row["success_rate"])
+                errors += [e["steady_state_error"] for e in row["per_episode"]]
             cells = " / ".join(f"{100 * r:.0f}" for r in rates)
             print(f"{name:66s} {cells:>20s} {100 * np.mean(rates):4.0f}% {np.nanmean(errors):9.1f}")
     finally:

@@ -40,7 +40,9 @@ def main() -> None:
         task = env.unwrapped.task
         print(f"\n{name}, seed {args.seed}")
         print("    t s   error ft  airspeed kt  pitch deg  climb ft/s  elevator  throttle")
-        for step in range(1, 10**6):
+        step, done = 0, False
+        while not done:
+            step += 1
             action = agent.act(obs)
             obs, _, terminated, truncated, info = env.step(action)
             state = env.unwrapped.world.slots[0].state
@@ -52,10 +54,8 @@ def main() -> None:
                     f"{step / flight.agent_hz:7.1f} {error:10.1f} {speed:12.1f} {pitch:10.1f}"
                     f" {climb:11.1f} {action[1]:9.2f} {action[3]:9.2f}"
                 )
-            if done:
-                if terminated:
-                    print(f"    ended: {info.get('reason') or 'terminated'}")
-                break
+            if terminated:
+                print(f"    ended: {info.get('reason') or 'terminated'}")
         env.close()
 
 
