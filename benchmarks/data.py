@@ -24,8 +24,9 @@ def dataset_build(episodes: int) -> Row:
 
     from gymfg_il.collectors.autopilot import record_autopilot
     from gymfg_il.collectors.config import CollectConfig
+    from gymfg_il.datasets.episode_record import episode_columns
     from gymfg_il.datasets.features import dataset_features
-    from gymfg_il.datasets.from_logs import build_from_logs, episode_columns
+    from gymfg_il.datasets.from_logs import build_from_logs
     from gymfg_il.recording.reader import read_log
     from gymfg_il.sim.properties import task_columns
 

@@ -13,9 +13,7 @@ hold it (a log copied under another name): by its frames.
 from __future__ import annotations
 
 import gc
-import json
 import logging
-import math
 import shutil
 import time
 from collections.abc import Sequence
@@ -28,6 +26,7 @@ import numpy as np
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.builder import DatasetBuilder
 from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs
+from gymfg_il.datasets.episode_record import episode_columns, episode_metadata
 from gymfg_il.datasets.features import WALL_TIME, check_compatible, dataset_features
 from gymfg_il.datasets.gather import (
     LogOutcome,
@@ -38,12 +37,11 @@ from gymfg_il.datasets.gather import (
     read_logs,
 )
 from gymfg_il.datasets.health import dataset_problems
-from gymfg_il.datasets.provenance import metadata_columns
-from gymfg_il.datasets.verify import differences, digest
+from gymfg_il.datasets.provenance import metadata_columns, write_columns
+from gymfg_il.datasets.verify import MARK, Checked, differences, digest
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views, episode_frames, image_key
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import Log, LoggedEpisode
-from gymfg_il.tasks.grades import rank
 from gymfg_il.viz.camera import Camera
 
 log = logging.getLogger(__name__)
@@ -65,103 +63,6 @@ class BuildReport:
     unreadable: list[Unreadable] = field(default_factory=list)  # files that are no log
     differences: list[str] = field(default_factory=list)  # why the old dataset was set aside
     aside: Path | None = None  # where it was kept
-
-
-def episode_columns(episode: LoggedEpisode, callsign: str) -> dict[str, np.ndarray]:
-    """One aircraft's logged episode as dataset columns (one frame per agent step)."""
-    steps = episode.steps[callsign]
-    done = np.zeros(len(steps), dtype=bool)
-    done[-1] = True
-    return {
-        "observation.state": steps.observation,
-        "action": steps.label,
-        "next.reward": steps.reward,
-        "next.done": done,
-        "intervention": steps.intervention,
-        WALL_TIME: _since_first(steps.wall_time),
-    }
-
-
-def _since_first(clock: np.ndarray) -> np.ndarray:
-    """Wall-clock seconds since the episode's first frame (where the log kept a time, else
-    -1): LeRobot loads floats as float32, which would round Unix seconds to minutes."""
-    if clock[0] < 0:
-        return np.full_like(clock, -1.0)
-    return np.where(clock >= 0, clock - clock[0], -1.0)
-
-
-def target_record(task: dict[str, Any], target: float | None) -> dict[str, Any]:
-    """How an episode's target is kept: ``target`` the fixed target (NaN where it moves or
-    the task has none), ``target_kind`` static, dynamic or none, and for a moving target
-    ``target_plan`` (JSON): the variable, where the target starts, how it moves (waypoints
-    drawn from ``target_range`` every ``hold_s`` s, approached at ``rate`` units/s; offsets
-    from the start value when ``relative``). The schedule itself follows from the seed."""
-    if task.get("dynamic"):
-        keys = ("variable", "relative", "target_range", "fixed_target", "rate", "hold_s")
-        plan: dict[str, Any] = {"start": None if target is None else float(target)}
-        plan |= {k: task[k] for k in keys if k in task}
-        return {"target": math.nan, "target_kind": "dynamic", "target_plan": json.dumps(plan)}
-    if target is None:
-        return {"target": math.nan, "target_kind": "none", "target_plan": ""}
-    return {"target": float(target), "target_kind": "static", "target_plan": ""}
-
-
-def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[str, Any]:
-    """The ``gymfg/*`` columns of one aircraft's episode: where it comes from and what was
-    flown (``spec``: the flight spec, JSON; ``target``: ``target_record``), who flew it and
-    how it went (``pilot``; ``success``: the task's verdict, 1 or 0, -1 where it was not
-    judged, with ``verdict`` in words; ``grade``: the task's (``tasks.grades``), or "";
-    ``mark``: the pilot's own, or "")."""
-    start, end = episode.start, episode.end or {}
-    target = episode.start_of(callsign).get("target")
-    info = log.aircraft(callsign)
-    task = info.get("task", {}).get("task", "")
-    return {
-        "aircraft": str(info.get("model", "")),
-        "callsign": callsign,
-        "team": str(info.get("team", "")),
-        "task": str(task),
-        **target_record(info.get("task", {}), target),
-        "seed": int(start.get("seed", -1)),
-        "source": str(start.get("source", log.session.get("source", ""))),
-        "noise": float(log.session.get("noise", 0.0)),
-        "interventions": int(episode.steps[callsign].intervention.sum()),
-        "iteration": int(start.get("iteration", 0)),
-        "outcome": str(end.get("outcome", "")),
-        "pilot": _text(start.get("pilot")),
-        "success": _verdict(end.get("success")),
-        "verdict": _text(end.get("verdict")),
-        "grade": str(end["grade"]) if rank(end.get("grade")) >= 0 else "",
-        **_timing(end),
-        "wall_start": float(episode.steps[callsign].wall_time[0]),  # Unix s, or -1
-        "mark": episode.mark,
-        "log": log.path.name,
-        "log_episode": int(episode.index),
-        "spec": log.spec.to_json(),
-        "jsbsim": str(log.session.get("versions", {}).get("jsbsim", "")),
-    }
-
-
-def _timing(end: dict[str, Any]) -> dict[str, Any]:
-    """A real-time episode's timing (``collectors.timing``): late frames, rate and jitter,
-    each -1 where the session ran as fast as it could or the log holds none."""
-    late = end.get("late_frames")
-    out: dict[str, Any] = {"late_frames": late if type(late) is int and late >= 0 else -1}
-    for key in ("rate_hz", "jitter_ms"):
-        value = end.get(key)
-        number = float(value) if isinstance(value, (int, float)) else math.nan  # a bool too
-        out[key] = number if math.isfinite(number) and number >= 0 else -1.0
-    return out
-
-
-def _verdict(success: Any) -> int:
-    """A logged verdict as its column holds it: 1, 0, or -1 where none was logged."""
-    return 1 if success is True else 0 if success is False else -1
-
-
-def _text(value: Any, limit: int = 200) -> str:
-    """A logged string as a column holds it (a log is hostile: anything else is "")."""
-    return value[:limit] if isinstance(value, str) else ""
 
 
 def _clean_leftovers(root: Path) -> None:
@@ -189,20 +90,22 @@ def _check(
     features: dict[str, Any],
     fps: int,
     logged: dict[EpisodeRef, dict[str, np.ndarray]],
-) -> tuple[list[str], list[EpisodeRef | None], list[str]]:
-    """(what keeps the dataset at ``root`` from being kept: it cannot be read whole, or it
-    differs from its logs; the log episode each of its episodes names; their digests).
+    records: dict[EpisodeRef, dict[str, Any]],
+) -> tuple[Checked, list[EpisodeRef | None]]:
+    """(what keeps the dataset at ``root`` from being kept, in ``Checked.problems``: it
+    cannot be read whole, or its frames or episode records differ from its logs; the log
+    episode each of its episodes names).
     Features or a rate other than the logs' are the dataset's damage when the logs hold every
     episode it has (the logs are the truth), else ConfigError: another task's dataset."""
     problems = dataset_problems(root)
     if problems:
-        return problems, [], []
+        return Checked(problems), []
     try:
         meta = lr.open_metadata(root)
     except Exception as err:  # any failure to load means: rebuild from the logs
-        return [f"LeRobot cannot load it ({type(err).__name__}: {err})"], [], []
+        return Checked([f"LeRobot cannot load it ({type(err).__name__}: {err})"]), []
     if meta.episodes is None or len(meta.episodes) != meta.total_episodes:
-        return ["its episode table does not list every episode"], [], []
+        return Checked(["its episode table does not list every episode"]), []
     refs = _refs(meta)
     try:
         check_compatible(meta.features, features, str(root))
@@ -213,10 +116,9 @@ def _check(
             )
     except ConfigError as err:
         if refs and all(ref in logged for ref in refs):
-            return [f"its info.json disagrees with the logs of its episodes ({err})"], refs, []
+            return Checked([f"its info.json disagrees with the logs of its episodes ({err})"]), refs
         raise
-    problems, digests = differences(root, meta, logged, refs)
-    return problems, refs, digests
+    return differences(root, meta, logged, refs, records), refs
 
 
 def build_from_logs(
@@ -288,6 +190,7 @@ def _build(
                         (lg, episode, callsign, EpisodeRef(lg.path.name, episode.index, callsign))
                     )
     logged = {ref: episode_columns(ep, c) for _, ep, c, ref in offered}
+    records = {ref: episode_metadata(lg, ep, c) for lg, ep, c, ref in offered}
     # frames flown in real time keep their wall time in a dataset made now (not in one
     # made without the column: its features stay)
     clock = any((columns[WALL_TIME] >= 0).any() for columns in logged.values())
@@ -298,7 +201,8 @@ def _build(
     digests: list[str] = []
     aside = None
     if root.exists():
-        found, refs, digests = _check(root, features, fps, logged)
+        checked, refs = _check(root, features, fps, logged, records)
+        found, digests = checked.problems, checked.digests
         if found:
             aside = root.with_name(f"{root.name}.broken-{time.strftime('%Y%m%d-%H%M%S')}")
             root.rename(aside)
@@ -312,6 +216,7 @@ def _build(
             refs, digests = [], []
         else:
             shutil.copytree(root, work)
+            write_columns(work, {MARK: checked.marks})  # marks given after the build
     outcomes = {lg.path.name: LogOutcome(lg.path.name, damaged=bool(lg.damage)) for lg in logs}
     # an episode already held, or held by an earlier log: by its frames
     holder: dict[str, EpisodeRef | int] = {}
@@ -339,7 +244,7 @@ def _build(
             builder.add_episode(
                 columns,
                 lg.aircraft(callsign)["task_description"],
-                episode_metadata(lg, episode, callsign),
+                records[ref],
                 pictures,
             )
             outcome.added.append(ref)

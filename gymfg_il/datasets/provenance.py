@@ -63,9 +63,6 @@ def restore(root: Path, meta: Any, sources: Sequence[Path]) -> int:
     """Write the ``gymfg/*`` columns into ``meta/episodes`` of the dataset at ``root`` (each
     file replaced atomically), each episode's taken from the source dataset that holds the
     same episode (by ``fingerprint``); the number of episodes restored (0: they have them)."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
     from gymfg_il.datasets import lerobot_api as lr
 
     if metadata_columns(meta):
@@ -87,13 +84,30 @@ def restore(root: Path, meta: Any, sources: Sequence[Path]) -> int:
             "repeatable)"
         )
     names = sorted({name for key in keys for name in known[key]})
+    values = {name: {e: known[key].get(name) for e, key in enumerate(keys)} for name in names}
+    return write_columns(root, values)
+
+
+def write_columns(root: Path, columns: dict[str, dict[int, Any]]) -> int:
+    """Set values of the episode table's ``columns`` (each {episode index: value}; an
+    episode left out keeps its value), adding the columns it lacks; each file replaced
+    atomically. The number of episodes in the files written."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
     done = 0
     for path in sorted((Path(root) / "meta" / "episodes").rglob("*.parquet")):
         table = pq.read_table(path)
         index = table["episode_index"].to_numpy()
-        for name in names:
-            values = [known[keys[int(i)]].get(name) for i in index]
-            table = table.append_column(name, pa.array(values))
+        if not any(int(i) in values for values in columns.values() for i in index):
+            continue
+        for name, values in columns.items():
+            at = table.schema.get_field_index(name)
+            old = table[name].to_pylist() if at >= 0 else [None] * len(index)
+            column = pa.array([values.get(int(i), v) for i, v in zip(index, old, strict=True)])
+            table = (
+                table.append_column(name, column) if at < 0 else table.set_column(at, name, column)
+            )
         tmp = path.with_name(f"{path.name}.tmp-{os.getpid()}")
         pq.write_table(table, tmp)
         os.replace(tmp, path)

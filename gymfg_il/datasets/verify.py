@@ -7,22 +7,28 @@ builder stores it (float32 state, action and reward, the done and intervention f
 environment state), and LeRobot's bookkeeping (episode, frame and global indexes, timestamps,
 task index) with what the episode table says. An episode no log holds is not checked: a
 rebuild could not replace it. Two episodes with the same frames, both of logs, are one
-episode twice.
+episode twice. An episode's record (its ``gymfg/*`` columns: verdict, pilot, seed, times...)
+is checked too (``train bc --select`` chooses episodes by it), but for the pilot's mark: a
+pilot may mark an episode after the dataset took it, and the build then takes the new mark.
 """
 
 from __future__ import annotations
 
 import hashlib
 from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from gymfg_il.datasets.episode_logs import EpisodeRef
+from gymfg_il.datasets.episode_record import record_differences
 from gymfg_il.datasets.features import ENVIRONMENT_STATE
+from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.sim.properties import task_columns
 
+MARK = "gymfg/mark"  # the pilot's own mark, which the log may give after the episode ended
 _BOOKKEEPING = ("episode_index", "frame_index", "index", "timestamp", "task_index")
 
 
@@ -96,19 +102,33 @@ def _first_difference(have: np.ndarray, want: np.ndarray) -> int:
     return int(np.argmin(same.reshape(len(same), -1).all(axis=1)))
 
 
+@dataclass
+class Checked:
+    """What ``differences`` found in a dataset."""
+
+    problems: list[str]  # what differs from its logs or itself, one line each
+    digests: list[str] = field(default_factory=list)  # each episode's ``digest``
+    # episodes whose pilot's mark the log gave after they were built: episode -> mark
+    marks: dict[int, str] = field(default_factory=dict)
+
+
 def differences(
     root: Path,
     meta: Any,
     logged: Mapping[EpisodeRef, Mapping[str, np.ndarray]],
     refs: list[EpisodeRef | None],
-) -> tuple[list[str], list[str]]:
-    """(what in the dataset at ``root`` differs from its logs or itself, one line each; each
-    episode's ``digest``). ``logged``: the columns of every log episode at hand
-    (``from_logs.episode_columns``); ``refs``: the log episode each dataset episode names."""
+    records: Mapping[EpisodeRef, Mapping[str, Any]],
+) -> Checked:
+    """What in the dataset at ``root`` differs from its logs or itself. ``logged``: the
+    columns of every log episode at hand (``episode_record.episode_columns``), ``records``
+    their ``gymfg/*`` columns (``episode_record.episode_metadata``); ``refs``: the log
+    episode each dataset episode names."""
     features = meta.features
     frames, problems = _frames(root, features)
     if problems:
-        return problems, []
+        return Checked(problems)
+    stored = metadata_columns(meta)
+    marks: dict[int, str] = {}
     episodes = meta.episodes
     order = np.argsort(frames["episode_index"], kind="stable")
     held, starts, counts = np.unique(
@@ -144,6 +164,11 @@ def differences(
         problems += [
             f"{name}: its {k} column is not as written" for k, ok in book.items() if not ok
         ]
+        record = dict(records[ref])
+        if MARK in stored and stored[MARK][e] != record["mark"]:
+            marks[e] = record.pop("mark")  # marked after it was built: not a difference
+        changed = record_differences({k: v[e] for k, v in stored.items()}, record)
+        problems += [f"{name}: {c}" for c in changed]
         twin = seen.setdefault(digests[-1], e)
         if twin != e:
             problems.append(f"{name}: the same episode as dataset episode {twin}")
@@ -158,4 +183,4 @@ def differences(
         problems.append(
             f"the data files hold frames of episodes {sorted(where)[:5]} no table lists"
         )
-    return problems, digests
+    return Checked(problems, digests, marks)

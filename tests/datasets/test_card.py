@@ -160,7 +160,7 @@ def test_appending_to_an_older_dataset_keeps_its_episode_columns(static, tmp_pat
     old = tmp_path / "old"
     builder = DatasetBuilder(old, "gymfg/old", 10, dataset_features(log.aircraft("ego")[
         "observation_names"]))  # fmt: skip
-    from gymfg_il.datasets.from_logs import episode_columns, episode_metadata
+    from gymfg_il.datasets.episode_record import episode_columns, episode_metadata
 
     ep = log.complete_episodes[0]
     meta = episode_metadata(log, ep, "ego")

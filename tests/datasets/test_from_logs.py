@@ -102,7 +102,7 @@ def test_a_broken_dataset_is_set_aside_and_rebuilt(built, tmp_path):
 def test_verdict_pilot_and_mark_columns_take_only_what_they_hold(built):
     import dataclasses
 
-    from gymfg_il.datasets.from_logs import episode_metadata
+    from gymfg_il.datasets.episode_record import episode_metadata
 
     _, result, _ = built
     log = read_log(result.log)
@@ -149,8 +149,8 @@ def test_a_wall_clock_column_where_frames_were_flown_in_real_time(built, tmp_pat
     import pyarrow.parquet as pq
 
     from gymfg_il.datasets.builder import DatasetBuilder
+    from gymfg_il.datasets.episode_record import episode_columns, episode_metadata
     from gymfg_il.datasets.features import dataset_features
-    from gymfg_il.datasets.from_logs import episode_columns, episode_metadata
     from gymfg_il.recording.reader import _clock
 
     out, result, _ = built

@@ -140,8 +140,8 @@ def test_a_copied_log_adds_nothing(copy, capsys):
 def test_a_dataset_that_holds_an_episode_twice_is_rebuilt(copy, capsys):
     """What the old recover made of a copied log: every episode twice."""
     from gymfg_il.datasets.builder import DatasetBuilder
+    from gymfg_il.datasets.episode_record import episode_columns, episode_metadata
     from gymfg_il.datasets.features import dataset_features
-    from gymfg_il.datasets.from_logs import episode_columns, episode_metadata
 
     (log,) = (copy / "logs").glob("*.mcap")
     twin = copy / "logs" / "zz-copy.mcap"
@@ -201,3 +201,54 @@ def test_unreadable_logs_are_set_aside_and_the_rest_rebuilt(copy, tmp_path):
     # the next recover finds a clean folder
     again = collect_("recover", str(copy))
     assert again.returncode == 0, again.stderr
+
+
+def set_episode_column(root, name, values):
+    """Write ``values`` (one per episode) as the episode table's column ``name``."""
+    import pyarrow as pa
+
+    (path,) = sorted((root / "meta" / "episodes").rglob("*.parquet"))
+    table = pq.read_table(path)
+    index = table.schema.get_field_index(name)
+    table = table.set_column(index, name, pa.array(values))
+    pq.write_table(table, path)
+
+
+@pytest.mark.parametrize(
+    "name, values",
+    [
+        ("gymfg/success", [1] * EPISODES),
+        ("gymfg/pilot", ["mallory"] * EPISODES),
+        ("gymfg/wall_start", [float("nan")] * EPISODES),
+        ("gymfg/wall_start", ["yesterday"] * EPISODES),
+        ("gymfg/seed", [7] * EPISODES),
+    ],
+)
+def test_an_episode_record_that_differs_from_the_log_is_rebuilt(copy, capsys, name, values):
+    """#52.1: recover compared frames only; every episode's gymfg/success set to 1 (or its
+    pilot, its wall-clock start) was kept ("took 4 episodes, 0 new") and `train bc --select
+    success` trained on the failed episodes. The record comes from the log like the frames."""
+    from gymfg_il.datasets.card import episode_columns as records
+
+    truth = records(copy / "dataset")
+    assert repr(truth[name]) != repr(values)  # the tampering changes something
+    set_episode_column(copy / "dataset", name, values)
+    assert collect.main(["recover", str(copy)]) == 0
+    out = capsys.readouterr().out
+    assert "rebuilt from the logs" in out and f"{name} is " in out
+    assert records(copy / "dataset") == truth
+    (aside,) = copy.glob("dataset.broken-*")
+    assert repr(records(aside)[name]) == repr(values)  # kept aside as it was found (NaN too)
+
+
+def test_a_mark_given_after_the_build_is_taken_in_place(copy, capsys):
+    """A person marks an episode after the session's dataset took it: the log's mark is the
+    truth, and the dataset takes it in place (not set aside as damaged)."""
+    from gymfg_il.datasets.card import episode_columns as records
+
+    truth = records(copy / "dataset")
+    set_episode_column(copy / "dataset", "gymfg/mark", ["failure"] * EPISODES)
+    assert collect.main(["recover", str(copy)]) == 0
+    assert "rebuilt" not in capsys.readouterr().out
+    assert records(copy / "dataset") == truth
+    assert not list(copy.glob("dataset.broken-*"))

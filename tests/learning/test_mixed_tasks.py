@@ -6,8 +6,9 @@ import pytest
 from gymfg_il.collectors.autopilot import record_autopilot
 from gymfg_il.collectors.config import CollectConfig
 from gymfg_il.datasets.builder import DatasetBuilder
+from gymfg_il.datasets.episode_record import episode_columns, episode_metadata
 from gymfg_il.datasets.features import dataset_features
-from gymfg_il.datasets.from_logs import build_from_logs, episode_columns, episode_metadata
+from gymfg_il.datasets.from_logs import build_from_logs
 from gymfg_il.errors import MixedTasksError
 from gymfg_il.learning.bc import train_bc
 from gymfg_il.learning.config import TrainConfig
