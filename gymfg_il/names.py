@@ -1,7 +1,8 @@
 """The one rule for names that reach logs, windows, files and the wire.
 
 Callsigns, team names, pilot names, aircraft model names and dataset repo ids are printable
-text of 1 to 64 characters (the online protocol's limit). A newline would forge a line in a
+text of 1 to 64 characters (the online protocol's limit), with no space at either end (a lone
+space would read as no name). A newline would forge a line in a
 log, ESC would drive the terminal that prints it, NUL cuts C strings, and a right-to-left
 override makes a name read as another; all are refused with the rule in the message.
 """
@@ -11,7 +12,10 @@ from __future__ import annotations
 from gymfg_il.errors import ConfigError
 
 NAME_MAX = 64
-RULE = f"printable characters only (no control, format or separator codes), 1 to {NAME_MAX} long"
+RULE = (
+    "printable characters only (no control, format or separator codes, no space at either "
+    f"end), 1 to {NAME_MAX} long"
+)
 
 
 class BadNameError(ConfigError):
@@ -29,6 +33,8 @@ def name_problem(value: object, what: str) -> str | None:
     if not value.isprintable():
         bad = next(c for c in value if not c.isprintable())
         return f"{what} {value!r} holds {bad!r} (U+{ord(bad):04X}); a {what} is {RULE}"
+    if value != value.strip():
+        return f"{what} {value!r} starts or ends with a space; a {what} is {RULE}"
     return None
 
 

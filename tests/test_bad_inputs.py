@@ -263,3 +263,11 @@ def test_a_reader_that_goes_away_ends_the_command_quietly():
 def test_recover_refuses_a_callsign_off_the_name_rule(tmp_path, capsys):
     assert collect.main(["recover", str(tmp_path), "--callsign", "a\nb"]) == 2
     one_error(capsys, "printable")
+
+
+@pytest.mark.parametrize("name", [" ", " ann", "ann ", "a|b", "ann\nbob", ""])
+def test_a_pilot_name_that_would_break_a_table_is_refused(tmp_path, capsys, name):
+    """#52.4: --pilot-name let '|' (which breaks the card's table) and a lone space through."""
+    assert collect.main(["manual", "--pilot-name", name, "--out", str(tmp_path / "s")]) == 2
+    one_error(capsys, "pilot name")
+    assert not (tmp_path / "s").exists()

@@ -22,6 +22,7 @@ from typing import Any, Literal
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views
 from gymfg_il.envs.options import FlightOptions
 from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.names import name_problem
 from gymfg_il.tasks.library import TASK_FAMILIES, TRACKED_TASKS
 from gymfg_il.typecheck import seed_problem, type_problems
 
@@ -181,8 +182,11 @@ class ManualConfig(CollectConfig):
         if not 0.0 <= self.skill <= 1.0:
             problems.append(f"skill={self.skill}: want 0 (a novice) .. 1 (an ace)")
         name = self.pilot_name
-        if name is not None and not (0 < len(name) <= 64 and name.isprintable()):
-            problems.append(f"pilot_name={name!r}: want 1-64 printable characters")
+        problem = None if name is None else name_problem(name, "pilot name")
+        if problem is None and name is not None and "|" in name:
+            problem = f"pilot name {name!r} holds '|', which tables of pilots use to separate"
+        if problem is not None:
+            problems.append(f"pilot_name: {problem}")
         return problems
 
 

@@ -18,18 +18,25 @@ the per-episode ``gymfg/*`` columns), so the card always describes what the fold
 from __future__ import annotations
 
 import json
-from collections import Counter
-from importlib.metadata import PackageNotFoundError, metadata, version
+from importlib.metadata import PackageNotFoundError, metadata
 from pathlib import Path
 from typing import Any
 
 from gymfg_il.datasets import lerobot_api as lr
+from gymfg_il.datasets.card_facts import (
+    PACKAGE,
+    aircraft,
+    as_float,
+    cell,
+    code,
+    facts,
+    installed,
+    jsbsim,
+)
 from gymfg_il.datasets.provenance import PREFIX
 from gymfg_il.sim.properties import ACTION_NAMES, BY_NAME, NAMES
-from gymfg_il.tasks.grades import GRADES, rank
 
 CARD = "README.md"
-PACKAGE = "gymfg-il"
 PAPER = (
     'none describes this dataset; GymFG-IL builds on the design of "GymFG: A Framework with '
     'a Gym Interface for FlightGear" (A. Wood, A. Sydney, P. Chin, B. Thapa, R. Ross)'
@@ -74,13 +81,6 @@ def unit_of(name: str) -> str:
     return "1"
 
 
-def _installed(package: str) -> str:
-    try:
-        return version(package)
-    except PackageNotFoundError:
-        return "unknown"
-
-
 def _license() -> str | None:
     """GymFG-IL's license as a Hub license id (``mit``), from the installed package's
     metadata (pyproject's ``project.license``); None when the package is not installed."""
@@ -90,73 +90,6 @@ def _license() -> str | None:
         return None
     found = meta.get("License-Expression") or meta.get("License")
     return str(found).lower() if found else None
-
-
-def _counted(values: list[Any]) -> str:
-    counts = Counter(str(v) for v in values if str(v))
-    return (
-        ", ".join(f"{k} ({n} episode{'s' * (n != 1)})" for k, n in sorted(counts.items()))
-        or "unknown"
-    )
-
-
-def _verdicts(success: list[Any]) -> str:
-    """How many episodes the task's own judge passed (``gymfg/success``: 1, 0, -1)."""
-    judged = [int(v) for v in success if int(v) >= 0]
-    if not judged:
-        return "not recorded"
-    unjudged = len(success) - len(judged)
-    return f"{sum(judged)} of {len(judged)} succeeded by the task's own judge" + (
-        f"; {unjudged} not judged" if unjudged else ""
-    )
-
-
-def _grades(grades: list[Any]) -> str:
-    """How many episodes earned each grade (``gymfg/grade``), best first."""
-    counts = Counter(str(g) for g in grades if rank(g) >= 0)
-    said = ", ".join(f"{counts[g]} {g}" for g in GRADES if counts[g])
-    return said or "not recorded"
-
-
-def _timing(episodes: dict[str, list[Any]], shown: int = 20) -> str:
-    """The rate and jitter of each episode flown in real time (``collectors.timing``)."""
-    late = episodes.get("gymfg/late_frames", [])
-    rate = episodes.get("gymfg/rate_hz", [-1.0] * len(late))
-    jitter = episodes.get("gymfg/jitter_ms", [-1.0] * len(late))
-    timed = [(i, n, r, j) for i, (n, r, j) in enumerate(zip(late, rate, jitter, strict=True))]
-    timed = [t for t in timed if int(t[1]) >= 0]
-    if not timed:
-        return "not recorded (no episode was flown in real time)"
-    said = [f"episode {i}: {r:.1f} Hz, jitter {j:.1f} ms, {n} late" for i, n, r, j in timed]
-    more = f"; {len(said) - shown} more" if len(said) > shown else ""
-    total = sum(int(t[1]) for t in timed)
-    flagged = sum(int(t[1]) > 0 for t in timed)
-    return (
-        f"{total} late frame(s) in {flagged} of {len(timed)} real-time episodes; "
-        + "; ".join(said[:shown])
-        + more
-    )
-
-
-def _pilots(episodes: dict[str, list[Any]]) -> str:
-    """Each named pilot's episodes, successes and grades (``gymfg/pilot``, ``gymfg/success``,
-    ``gymfg/grade``)."""
-    names = episodes.get("gymfg/pilot", [])
-    success = episodes.get("gymfg/success", [-1] * len(names))
-    grades = episodes.get("gymfg/grade", [""] * len(names))
-    flown: dict[str, list[tuple[int, str]]] = {}
-    for name, ok, graded in zip(names, success, grades, strict=True):
-        if name:
-            flown.setdefault(str(name), []).append((int(ok), str(graded)))
-    return (
-        "; ".join(
-            f"{name}: {len(eps)} episode{'s' * (len(eps) != 1)}, "
-            f"{sum(ok == 1 for ok, _ in eps)} succeeded"
-            + (f" ({_grades([g for _, g in eps])})" if any(rank(g) >= 0 for _, g in eps) else "")
-            for name, eps in sorted(flown.items())
-        )
-        or "not named"
-    )
 
 
 def episode_columns(root: Path) -> dict[str, list[Any]]:
@@ -172,66 +105,16 @@ def episode_columns(root: Path) -> dict[str, list[Any]]:
     return out
 
 
-def _jsbsim(episodes: dict[str, list[Any]]) -> str:
-    recorded = sorted({str(v) for v in episodes.get("gymfg/jsbsim", []) if v})
-    return ", ".join(recorded) or (
-        f"version not recorded; {_installed('jsbsim')} where this card was written"
-    )
-
-
-def _facts(meta: Any, episodes: dict[str, list[Any]], specs: list[Any]) -> list[tuple[str, str]]:
-    """The card's table: what the dataset holds, one row per fact."""
-    features = meta.features
-    known = bool(episodes)
-    sim_hz = ", ".join(str(h) for h in sorted({s.sim_hz for s in specs})) or "unknown"
-    weather = {
-        f"turbulence {s.turbulence}, wind {s.wind_kt:g} kt"
-        + (f" from {s.wind_from_deg:g} deg" if s.wind_from_deg is not None else "")
-        for s in specs
-    }
-    starts = {"trimmed straight, level flight" if s.trimmed_starts else "untrimmed" for s in specs}
-    kinds = episodes.get("gymfg/target_kind", [])
-    aircraft = sorted(set(episodes.get("gymfg/aircraft", []))) or [str(meta.robot_type)]
-    cameras = [
-        f"`{k}` ({f['shape'][1]}x{f['shape'][0]} video)"
-        for k, f in features.items()
-        if f.get("dtype") == "video"
-    ]
-    ends = [v for v in episodes.get("gymfg/outcome", []) if v]
-    return [
-        (
-            "data",
-            f"simulated: the JSBSim flight dynamics model (JSBSim {_jsbsim(episodes)}); "
-            "no real aircraft flew",
-        ),
-        ("aircraft", ", ".join(aircraft)),
-        ("tasks", _counted(episodes.get("gymfg/task", [])) if known else "unknown"),
-        ("targets", _counted(kinds) if kinds else "not recorded"),
-        ("sources", _counted(episodes.get("gymfg/source", [])) if known else "unknown"),
-        (
-            "DART noise (action std)",
-            _counted(episodes.get("gymfg/noise", [])) if known else "unknown",
-        ),
-        ("weather", "; ".join(sorted(weather)) or "unknown"),
-        ("starts", ", ".join(sorted(starts)) or "unknown"),
-        ("episode ends", _counted(ends) if ends else "not recorded"),
-        ("verdicts", _verdicts(episodes.get("gymfg/success", []))),
-        ("grades", _grades(episodes.get("gymfg/grade", []))),
-        ("timing", _timing(episodes)),
-        ("pilots", _pilots(episodes)),
-        ("pilots' marks", _counted(episodes.get("gymfg/mark", [])).replace("unknown", "none")),
-        ("rates", f"{meta.fps} fps (agent steps); JSBSim at {sim_hz} Hz"),
-        ("episodes", f"{meta.total_episodes} ({meta.total_frames} frames)"),
-        ("cameras", ", ".join(cameras) or "none"),
-        ("card written by", f"GymFG-IL {_installed(PACKAGE)}"),
-    ]
+def _literal(text: str) -> str:
+    """``text`` as a Python string literal that cannot close the card's code block."""
+    return json.dumps(text).replace("`", "\\u0060")
 
 
 def _source(name: str) -> str:
     assist, _, person = name.rpartition("+")
     if assist and person in SOURCES:
         return (
-            f"{SOURCES[person]}; they took over from `{assist}` when they chose (the "
+            f"{SOURCES[person]}; they took over from {code(assist)} when they chose (the "
             "`intervention` column marks the frames they flew)"
         )
     return SOURCES.get(name, "not described here (a source GymFG-IL does not know)")
@@ -242,24 +125,24 @@ def limitations(
 ) -> list[str]:
     """The card's Limitations section (Markdown lines): what the data is not, read from the
     dataset (``names``: the observation's)."""
-    aircraft = sorted(set(episodes.get("gymfg/aircraft", []))) or [str(meta.robot_type)]
+    flown = aircraft(meta, episodes)
     sources = sorted({str(s) for s in episodes.get("gymfg/source", []) if s})
-    noisy = any(float(n) > 0 for n in episodes.get("gymfg/noise", []))
+    noisy = any(as_float(n, 0.0) > 0 for n in episodes.get("gymfg/noise", []))
     longest = max((s.episode_time_s for s in specs), default=None)
     # the catalogue's commands are the flown actions, its clock the frame's timestamp
     unobserved = [n for n in NAMES if n not in names and not n.endswith(("_cmd", "_time_s"))]
     cameras = [k for k, f in meta.features.items() if f.get("dtype") == "video"]
-    who = [f"  - `{s}`: {_source(s)}." for s in sources] or ["  - not recorded."]
+    who = [f"  - {code(s)}: {_source(s)}." for s in sources] or ["  - not recorded."]
     lines = [
         "### Limitations",
         "",
         f"- **Simulated flight only.** Every frame was computed by JSBSim "
-        f"({_jsbsim(episodes)}); no real aircraft or sensor is behind it. Observations "
+        f"({jsbsim(episodes)}); no real aircraft or sensor is behind it. Observations "
         "are the simulator's exact values: no sensor noise, bias, latency or failure.",
-        f"- **Aircraft models.** {', '.join(f'`{a}`' for a in aircraft)}: JSBSim's own "
+        f"- **Aircraft models.** {', '.join(map(code, flown))}: JSBSim's own "
         + (
             "model of that name as the `jsbsim` package ships it: what it computes"
-            if len(aircraft) == 1
+            if len(flown) == 1
             else "models of those names as the `jsbsim` package ships them: what they compute"
         )
         + ", not flight-test data of the aircraft. No other aircraft is in the data.",
@@ -312,9 +195,9 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
         "",
         "| | |",
         "| --- | --- |",
-        *(f"| {k} | {v} |" for k, v in _facts(meta, episodes, specs)),
+        *(f"| {k} | {v} |" for k, v in facts(meta, episodes, specs)),
         "",
-        "Per-frame task strings: " + ("; ".join(f"`{t}`" for t in tasks) or "none") + ".",
+        "Per-frame task strings: " + ("; ".join(cell(t, 200) for t in tasks) or "none") + ".",
         "Per-episode metadata (seed, source, target, flight spec, log) is in the `gymfg/*` "
         "columns of `meta/episodes`.",
         "",
@@ -322,7 +205,7 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
         "",
         "| index | name | unit |",
         "| --- | --- | --- |",
-        *(f"| {i} | {n} | {unit_of(n)} |" for i, n in enumerate(names)),
+        *(f"| {i} | {cell(n)} | {cell(unit_of(n))} |" for i, n in enumerate(names)),
         "",
         "### Action (`action`)",
         "",
@@ -342,7 +225,7 @@ def description(meta: Any, episodes: dict[str, list[Any]], repo_id: str, root: P
         'os.environ["HF_HUB_OFFLINE"] = "1"  # a local folder: never ask the Hub',
         "from lerobot.datasets.lerobot_dataset import LeRobotDataset",
         "",
-        f"ds = LeRobotDataset({json.dumps(repo_id)}, root={json.dumps(str(root))})",
+        f"ds = LeRobotDataset({_literal(repo_id)}, root={_literal(str(root))})",
         "```",
     ]
     return "\n".join(lines)
@@ -366,7 +249,7 @@ def card_text(
         paper=PAPER,
         citation=(
             "No BibTeX: no publication describes this dataset. To say how it was made, name "
-            f"GymFG-IL {_installed(PACKAGE)} and the JSBSim version above."
+            f"GymFG-IL {installed(PACKAGE)} and the JSBSim version above."
         ),
     )
 

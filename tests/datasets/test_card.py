@@ -174,3 +174,48 @@ def test_appending_to_an_older_dataset_keeps_its_episode_columns(static, tmp_pat
     assert report.added == 1 and report.total_episodes == 2
     frames = load_frames(old)
     assert len(frames) == 80 and "gymfg/target_kind" not in frames.episodes
+
+
+def set_episode_column(root, name, values):
+    import pyarrow as pa
+
+    (path,) = sorted((root / "meta" / "episodes").rglob("*.parquet"))
+    table = pq.read_table(path)
+    at = table.schema.get_field_index(name)
+    table = table.set_column(at, name, pa.array(values))
+    pq.write_table(table, path)
+
+
+@pytest.mark.parametrize(
+    "pilots, success",
+    [
+        (["ann\n## Pwned\n<script>alert(1)</script>", "bob"], [0, 1]),
+        (["nul\x00here", "a|b|c"], [1, 0]),
+        (["x" * 2_000_000, " "], [0, 0]),
+        (["ann", "ann"], [None, 1]),  # #52.2: a null verdict
+        (["ann", "bob"], ["yes", "no"]),  # #52.2: verdicts that are not integers
+    ],
+)
+def test_a_card_shows_hostile_records_escaped_and_bounded(
+    static, tmp_path, capsys, pilots, success
+):
+    """#52.4 and #52.2: `collect repair` copied gymfg/pilot into the card's table as it was
+    (a newline escaped the table into a heading and raw <script>, a NUL made the card binary,
+    a 2 MB name was copied whole) and died on a null or non-integer gymfg/success."""
+    import shutil
+
+    from gymfg_il import collect as collect_cli
+
+    result, _ = static
+    root = tmp_path / "dataset"
+    shutil.copytree(result.log.parent.parent / "dataset", root)
+    set_episode_column(root, "gymfg/pilot", pilots)
+    set_episode_column(root, "gymfg/success", success)
+    (root / "README.md").unlink()
+    assert collect_cli.main(["repair", str(root)]) == 0
+    assert "Traceback" not in capsys.readouterr().err
+    card = (root / "README.md").read_text(encoding="utf-8")
+    assert "\x00" not in card and "<script>" not in card and len(card) < 20_000
+    (row,) = [line for line in card.splitlines() if line.startswith("| pilots |")]
+    assert row.count("|") - row.count("\\|") == 3  # the row's own three bars, no more
+    assert not any(line.startswith("## Pwned") for line in card.splitlines())
