@@ -56,10 +56,29 @@ def _column(table: Any, name: str) -> np.ndarray:
 def _frames(root: Path, features: Mapping[str, Any]) -> tuple[dict[str, np.ndarray], list[str]]:
     """Every data file's non-video columns, concatenated; and what could not be read."""
     import pyarrow as pa
-    import pyarrow.parquet as pq
 
     names = [k for k, f in features.items() if f.get("dtype") != "video"]
     names += [k for k in _BOOKKEEPING if k not in names]
+    tables, problems = _read(root, names)
+    if problems or not tables:
+        return {}, problems or ["data/ holds no data files"]
+    table = pa.concat_tables(tables)
+    return {name: _column(table, name) for name in table.column_names}, []
+
+
+def page_problems(root: Path, features: Mapping[str, Any]) -> list[str]:
+    """What in the data files of the dataset at ``root`` fails its page checksums (where the
+    builder wrote them) or cannot be decoded: damage that may still read as numbers."""
+    names = [k for k, f in features.items() if f.get("dtype") != "video"]
+    return _read(root, names)[1]
+
+
+def _read(root: Path, names: list[str]) -> tuple[list[Any], list[str]]:
+    """The ``names`` columns of each data file (Arrow tables), their page checksums verified;
+    and what could not be read."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
     tables, problems = [], []
     for path in sorted((root / "data").rglob("*.parquet")):
         where = path.relative_to(root)
@@ -77,10 +96,7 @@ def _frames(root: Path, features: Mapping[str, Any]) -> tuple[dict[str, np.ndarr
         problems += bad
         if not bad:
             tables.append(pa.table(columns))
-    if problems or not tables:
-        return {}, problems or ["data/ holds no data files"]
-    table = pa.concat_tables(tables)
-    return {name: _column(table, name) for name in table.column_names}, []
+    return tables, problems
 
 
 def _expected(

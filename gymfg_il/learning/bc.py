@@ -155,13 +155,14 @@ def demonstrations(
     frames), checked to be of one task and finite, selected, shifted by the pilot's reaction
     (``cfg.shift``: what was shifted goes into ``record``), from each pilot's first input,
     less what a policy flew unaided."""
-    from gymfg_il.learning.data import check_tasks, load_frames, selected
+    from gymfg_il.learning.data import check_tasks, load_frames
     from gymfg_il.learning.data_checks import check_trainable
+    from gymfg_il.learning.selection import once_each, selected
 
     if frames is None or (camera is not None and frames.camera != camera):
         frames = load_frames(cfg.dataset, camera)
     check_tasks(frames.episodes, cfg.mixed_tasks)
-    frames = selected(frames, cfg.select, cfg.dataset)
+    frames = selected(once_each(frames, cfg.dataset), cfg.select, cfg.dataset)
     if cfg.shift != "0":
         from gymfg_il.learning.reaction import shifted
 
@@ -197,7 +198,7 @@ def _batches(
     """The training batches and the validation batches (None where there are no held-out
     episodes, or they are too short for a window)."""
     from gymfg_il.learning.batches import TensorBatches
-    from gymfg_il.learning.data import grade_weights
+    from gymfg_il.learning.selection import grade_weights
 
     weights = grade_weights(train, cfg.dataset) if cfg.weight == "grade" else None
     batches = TensorBatches(train, cfg.batch_size, device, cfg.seed, window, weights)

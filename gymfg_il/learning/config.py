@@ -4,6 +4,7 @@ the data: how many epochs, which device."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -113,7 +114,9 @@ class TrainConfig:
         if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
             problems.append(f"device={self.device!r}: use cpu, cuda, cuda:N or auto")
         problems += [selection_problem(term) for term in self.select if selection_problem(term)]
-        if self.shift != "auto" and not (self.shift.isdigit() and int(self.shift) <= 120):
+        if self.shift != "auto" and not (
+            re.fullmatch("[0-9]{1,3}", self.shift) and int(self.shift) <= 120
+        ):
             problems.append(f"shift={self.shift!r}: want a number of steps (0-120) or auto")
         if self.weight not in ("", "grade"):
             problems.append(f"weight={self.weight!r}: want grade, or leave it out")

@@ -14,10 +14,10 @@ import numpy as np
 from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.health import dataset_problems
 from gymfg_il.datasets.provenance import metadata_columns
+from gymfg_il.datasets.verify import page_problems
 from gymfg_il.datasets.videos import decode_camera, image_key
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError, MixedTasksError, join_problems
-from gymfg_il.learning.config import GRADE_WEIGHTS
 from gymfg_il.learning.data_checks import (
     FEATURES,
     column_problems,
@@ -26,7 +26,6 @@ from gymfg_il.learning.data_checks import (
     rebuild_hint,
     stats_problems,
 )
-from gymfg_il.tasks.grades import rank
 
 
 @dataclass
@@ -123,51 +122,6 @@ def episode_runs(episode: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     first = np.maximum.accumulate(np.where(starts, np.arange(n), 0))
     end = np.r_[np.flatnonzero(starts)[1:], n][np.cumsum(starts) - 1]
     return first, end
-
-
-def selected(frames: Frames, terms: list[str], where: Path | str) -> Frames:
-    """The episodes of ``frames`` that meet every ``terms`` (``TrainConfig.select``)."""
-    if not terms:
-        return frames
-    eps = frames.episodes
-    ids = eps.get("episode_index", list(range(len(eps.get("gymfg/seed", [])))))
-    keep = np.ones(len(ids), dtype=bool)
-    for term in terms:
-        key, _, value = term.partition("=")
-        column = "success" if key in ("success", "failure") else key
-        values = eps.get(f"gymfg/{column}")
-        if values is None or len(values) != len(ids):
-            raise ConfigError(
-                f"{where} records no gymfg/{column} per episode (built before it was "
-                f"stored), so --select {term} cannot choose: build it afresh from its logs "
-                "(move FOLDER/dataset aside, then python -m gymfg_il.collect recover FOLDER), "
-                "or drop --select"
-            )
-        if key in ("success", "failure"):
-            keep &= np.array([int(v) == (key == "success") for v in values])
-        elif key == "grade":  # that grade or a better one
-            keep &= np.array([0 <= rank(v) <= rank(value) for v in values])
-        else:
-            keep &= np.array([str(v) == value for v in values])
-    if not keep.any():
-        raise ConfigError(f"--select {' '.join(terms)}: no episode of {where} meets it")
-    return frames.select(np.asarray(ids)[keep])
-
-
-def grade_weights(frames: Frames, where: Path | str) -> np.ndarray:
-    """Each frame's sampling weight from its episode's grade (``TrainConfig.weight``)."""
-    eps = frames.episodes
-    grades = eps.get("gymfg/grade")
-    ids = eps.get("episode_index", list(range(len(grades or []))))
-    if grades is None or len(grades) != len(ids) or min(map(rank, grades), default=-1) < 0:
-        raise ConfigError(
-            f"{where}: not every episode records a grade (gymfg/grade; a dataset built before "
-            "grades were stored, or of a source nobody graded), so --weight grade cannot "
-            "weigh them: build it afresh from its logs (move FOLDER/dataset aside, then "
-            "python -m gymfg_il.collect recover FOLDER), or drop --weight"
-        )
-    by_episode = {int(i): GRADE_WEIGHTS[str(g)] for i, g in zip(ids, grades, strict=True)}
-    return np.array([by_episode[int(e)] for e in frames.episode], dtype=np.float64)
 
 
 def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
@@ -303,6 +257,7 @@ def load_frames(root: Path, camera: str | None = None) -> Frames:
     table = ds.hf_dataset.data.table
     stats = ds.meta.stats
     problems = column_problems(table, ds.meta.episodes, features)
+    problems += page_problems(root, features)  # damage LeRobot's reader takes as numbers
     problems += stats_problems(stats, {k: list(features[k]["names"]) for k in FEATURES})
     if problems:
         raise ConfigError(
@@ -312,6 +267,7 @@ def load_frames(root: Path, camera: str | None = None) -> Frames:
     if ds.meta.episodes is not None:
         for name in ("episode_index", "length"):
             episodes[name] = list(ds.meta.episodes[name])
+        _check_episode_index(table, episodes["episode_index"], root)
     return Frames(
         obs=_column(table, "observation.state").astype(np.float32),
         action=_column(table, "action").astype(np.float32),
@@ -331,6 +287,18 @@ def load_frames(root: Path, camera: str | None = None) -> Frames:
         images=None if camera is None else decode_camera(root, image_key(camera), ds.meta),
         camera=camera,
     )
+
+
+def _check_episode_index(table: Any, listed: list[Any], root: Path) -> None:
+    """The episode table lists each episode of the data files once, in order (a rewritten
+    ``episode_index`` would attach one episode's record to another's frames)."""
+    held = np.unique(_column(table, "episode_index"))
+    if [int(i) for i in listed] != list(range(len(listed))) or not np.isin(held, listed).all():
+        raise ConfigError(
+            f"the dataset at {root} is damaged: meta/episodes lists episode_index "
+            f"{[int(i) for i in listed][:8]}..., the data files hold episodes "
+            f"{held[:8].tolist()}...; want 0, 1, 2, ... in both" + rebuild_hint(root)
+        )
 
 
 def split_by_episode(

@@ -25,6 +25,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gymfg_il.errors import ConfigError
+
 if TYPE_CHECKING:
     from gymfg_il.learning.data import Frames
 
@@ -95,6 +97,14 @@ def shifted(frames: Frames, shift: str) -> tuple[Frames, dict[str, Any]]:
     number, for every episode; ``auto``: each pilot's estimate, on the episodes a person or
     the synthetic pilot flew), and what was shifted by how much, for the run's record."""
     if shift == "auto":
+        sources = frames.episodes.get("gymfg/source")
+        if not sources or len(sources) != len(frames.episodes.get("episode_index", sources)):
+            raise ConfigError(
+                "--shift auto estimates each pilot's reaction from the episodes' records "
+                "(gymfg/source, gymfg/pilot), which this dataset lacks (LeRobot's dataset "
+                "editing drops them): restore them with python -m gymfg_il.collect repair "
+                "EDITED --source ORIGINAL, or give the steps (--shift N)"
+            )
         found = reactions(frames)
         pilots = pilot_of(frames)
         steps = {e: found.get(pilots[e]) or 0 for e in pilots}

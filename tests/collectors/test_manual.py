@@ -357,7 +357,7 @@ def test_a_mark_needs_an_ended_episode(tmp_path):
 
 def test_train_selects_episodes_by_pilot_mark_and_verdict(tmp_path):
     from gymfg_il.learning.config import TrainConfig
-    from gymfg_il.learning.data import selected
+    from gymfg_il.learning.selection import selected
 
     fly = {1: [lambda: key(pygame.K_SPACE)], 100: [lambda: key(pygame.K_q)]}
     run(tmp_path, {**fly, 95: [lambda: key(pygame.K_g)]}, pilot_name="ann")

@@ -12,7 +12,8 @@ from gymfg_il.errors import ConfigError
 from gymfg_il.learning.batches import TensorBatches
 from gymfg_il.learning.bc import train_bc
 from gymfg_il.learning.config import GRADE_WEIGHTS, TrainConfig
-from gymfg_il.learning.data import grade_weights, load_frames, selected
+from gymfg_il.learning.data import load_frames
+from gymfg_il.learning.selection import grade_weights, selected
 
 GRADED = ["excellent", "good", "fair", "unsatisfactory", "good", "fair"]
 
