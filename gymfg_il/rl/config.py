@@ -10,7 +10,7 @@ from typing import Literal
 
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.sim.weather import Turbulence
-from gymfg_il.typecheck import type_problems
+from gymfg_il.typecheck import SEED_LIMIT, SEED_RULE, seed_problem, type_problems
 
 ANCHOR_SPAN_MAX = 150_000  # the longest the anchor decays over by default (``anchor_steps``)
 # the actor's default learning rate when fine-tuning (``actor_lr``); from scratch it is ``lr``
@@ -192,7 +192,7 @@ class PPORunConfig:
                 f"select_episodes={self.select_episodes} must be >= eval_episodes="
                 f"{self.eval_episodes} (the kept actor is chosen on the curve's seeds and more)"
             )
-        problems += self._rollout_problems()
+        problems += self._rollout_problems() + self._seed_problems()
         if self.sde_every < 0:
             problems.append(f"sde_every={self.sde_every}: want 0 (once a rollout) or more")
         if not 0 < self.lr < 1:
@@ -233,6 +233,23 @@ class PPORunConfig:
         if problems:
             raise ConfigError(join_problems("train ppo", problems))
         self.init = None if self.init is None else Path(self.init)
+
+    def _seed_problems(self) -> list[str]:
+        """Every seed the run takes held to the one seed rule (``typecheck.seed_problem``):
+        the envs' (env k starts from seed + k; stable-baselines3 seeds numpy's legacy
+        generator with ``seed``) and the held-out episodes' (eval_seed + i, up to the last
+        episode the kept actor is chosen on)."""
+        problems = []
+        if problem := seed_problem(self.seed):
+            problems.append(problem)
+        elif self.envs >= 0 and (last := self.seed + self.n_envs - 1) >= SEED_LIMIT:
+            problems.append(
+                f"seed={self.seed}: env {last - self.seed} starts from seed {last}, and a seed "
+                f"is an integer {SEED_RULE}; give --seed {SEED_LIMIT - self.n_envs} or below"
+            )
+        if problem := seed_problem(self.eval_seed, self.chosen_on):
+            problems.append(f"eval_{problem}")  # "seed=...: why" names the flag
+        return problems
 
     def _rollout_problems(self) -> list[str]:
         """What stable-baselines3's PPO would stop on (an assertion, after the start's

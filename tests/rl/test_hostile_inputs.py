@@ -59,3 +59,31 @@ def test_the_batch_must_divide_the_rollout(bc_policy):
         PPORunConfig(init=bc_policy, envs=1, rollout_steps=1, batch_size=2)
     assert PPORunConfig(init=bc_policy, envs=3, rollout_steps=100, batch_size=60).rollout == 300
     assert PPORunConfig(init=bc_policy, envs=2, rollout_steps=1, batch_size=2).rollout == 2
+
+
+LAST = 2**32 - 1  # the largest seed
+
+
+@pytest.mark.parametrize(
+    ("flags", "needle"),
+    [
+        (["--seed", "-1"], "seed=-1"),
+        (["--eval-seed", "-1"], "eval_seed=-1"),
+        (["--seed", str(2**32)], f"seed={2**32}"),
+        (["--eval-seed", str(2**32)], f"eval_seed={2**32}"),
+        # the envs' and the held-out episodes' seeds follow the first
+        (["--seed", str(LAST), "--envs", "2"], f"env 1 starts from seed {2**32}"),
+        (["--eval-seed", str(LAST), "--keep", "last", "--eval-episodes", "2"], "episode 1 has"),
+        (["--eval-seed", str(LAST - 2)], f"episode 63 has seed {2**32 + 60}"),  # 64 to choose on
+    ],
+)
+def test_every_seed_is_held_to_the_seed_rule(
+    bc_policy, tmp_path, capsys, nothing_loaded, flags, needle
+):
+    assert main(_ppo(bc_policy, tmp_path / "ppo", *flags)) == 2
+    one_error(capsys, needle, "0 <= seed < 2**32")
+
+
+def test_the_last_seeds_are_taken(bc_policy):
+    cfg = PPORunConfig(init=bc_policy, seed=LAST - 1, envs=2, eval_seed=LAST - 63)
+    assert (cfg.seed + cfg.n_envs - 1, cfg.eval_seed + cfg.chosen_on - 1) == (LAST, LAST)
