@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Literal
 
 from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.rl.folders import overlap_problem
 from gymfg_il.sim.weather import Turbulence
 from gymfg_il.typecheck import SEED_LIMIT, SEED_RULE, seed_problem, type_problems
 
@@ -193,6 +194,8 @@ class PPORunConfig:
                 f"{self.eval_episodes} (the kept actor is chosen on the curve's seeds and more)"
             )
         problems += self._rollout_problems() + self._seed_problems()
+        if problem := overlap_problem(self.init, self.out):
+            problems.append(problem)
         if self.sde_every < 0:
             problems.append(f"sde_every={self.sde_every}: want 0 (once a rollout) or more")
         if not 0 < self.lr < 1:

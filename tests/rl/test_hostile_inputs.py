@@ -5,6 +5,9 @@ killed run's scratch folder is cleared by the next run."""
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
+
 import pytest
 
 from gymfg_il.errors import ConfigError
@@ -29,6 +32,17 @@ def nothing_loaded(monkeypatch):
         raise AssertionError(f"the run loaded {cfg.init} before refusing")
 
     monkeypatch.setattr("gymfg_il.rl.start.starting_policy", loaded)
+
+
+@pytest.fixture
+def nothing_flown(monkeypatch):
+    """Fails the test if the run gets as far as its first evaluation."""
+    from gymfg_il.rl.judge import Judge
+
+    def flown(*args, **kwargs):
+        raise AssertionError("an evaluation began before the run was refused")
+
+    monkeypatch.setattr(Judge, "__init__", flown)
 
 
 def _ppo(bc_policy, out, *more):
@@ -87,3 +101,42 @@ def test_every_seed_is_held_to_the_seed_rule(
 def test_the_last_seeds_are_taken(bc_policy):
     cfg = PPORunConfig(init=bc_policy, seed=LAST - 1, envs=2, eval_seed=LAST - 63)
     assert (cfg.seed + cfg.n_envs - 1, cfg.eval_seed + cfg.chosen_on - 1) == (LAST, LAST)
+
+
+def _inside(bc_policy, tmp_path, layout):
+    """(init, out) laid out as ``layout`` says, the starting policy a copy of ``bc_policy``."""
+    if layout == "init inside out":  # a step checkpoint of an earlier run to the same out
+        init, out = tmp_path / "run/checkpoints/step-0", tmp_path / "run"
+    else:
+        init = tmp_path / "bc"
+        out = {"same": init, "out inside init": init / "ppo", "a link to init": tmp_path / "link"}
+        out = out[layout]
+    shutil.copytree(bc_policy, init)
+    if layout == "a link to init":
+        out.symlink_to(init, target_is_directory=True)
+    return init, out
+
+
+@pytest.mark.parametrize("layout", ["same", "out inside init", "a link to init", "init inside out"])
+def test_out_never_lands_in_or_over_the_starting_policy(
+    bc_policy, tmp_path, capsys, nothing_flown, layout
+):
+    init, out = _inside(bc_policy, tmp_path, layout)
+    before = {p.name: p.read_bytes() for p in init.iterdir()}
+    flags = ["--steps", "64", "--envs", "1", "--rollout-steps", "64", "--batch-size", "64"]
+    assert main(_ppo(init, out, *flags)) == 2
+    inside = "--init" if layout == "init inside out" else "--out"
+    one_error(capsys, inside, "give an --out")
+    assert {p.name: p.read_bytes() for p in init.iterdir()} == before
+    assert [p.name for p in tmp_path.glob(".*")] == []  # no staging folder either
+
+
+def test_the_default_out_is_held_apart_too(bc_policy, tmp_path, monkeypatch, nothing_flown):
+    from gymfg_il.rl.run import train_ppo
+
+    shutil.copytree(bc_policy, tmp_path / "bc")
+    monkeypatch.chdir(tmp_path / "bc")  # the default out, policies/ppo-..., lies inside it
+    cfg = PPORunConfig(init=Path("."), steps=64, envs=1, rollout_steps=64, batch_size=64)
+    with pytest.raises(ConfigError, match=r"--out policies/ppo-altitude-c172p lies inside"):
+        train_ppo(cfg)
+    assert not (tmp_path / "bc/policies").exists()
