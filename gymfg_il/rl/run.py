@@ -20,7 +20,6 @@ import logging
 import math
 import os
 import shutil
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -35,7 +34,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 from gymfg_il.errors import ConfigError
 from gymfg_il.rl.config import PPORunConfig
 from gymfg_il.rl.env import make_env
-from gymfg_il.rl.folders import out_folder
+from gymfg_il.rl.folders import out_folder, scratch_folder
 from gymfg_il.rl.judge import EvalPoint, Judge, choose, plot_curve
 from gymfg_il.rl.policy import AnchoredPolicy
 from gymfg_il.rl.start import Start, as_ppo, meta_of, starting_policy, stats_of
@@ -94,7 +93,7 @@ def _train(
     seeds = list(range(cfg.eval_seed, cfg.eval_seed + cfg.eval_episodes))
     more = list(range(seeds[-1] + 1, cfg.eval_seed + cfg.chosen_on))
     began = time.perf_counter()
-    scratch_dir = Path(tempfile.mkdtemp(prefix="gymfg-ppo-"))
+    scratch_dir = scratch_folder()  # removed below; a killed run's, by a later run
     # the evaluations' processes, started before the envs' (the env processes wait while an
     # evaluation flies)
     pool = Workers(min(2, len(os.sched_getaffinity(0)))) if more else Workers(1)

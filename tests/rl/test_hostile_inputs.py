@@ -5,7 +5,13 @@ killed run's scratch folder is cleared by the next run."""
 
 from __future__ import annotations
 
+import os
 import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
 from pathlib import Path
 
 import pytest
@@ -15,6 +21,9 @@ from gymfg_il.rl.config import PPORunConfig
 from gymfg_il.train import main
 
 pytest.importorskip("stable_baselines3")
+
+ROOT = Path(__file__).resolve().parents[2]
+KILL_DEADLINE_S = 300  # a loaded 2-core machine imports torch slowly; only a failure waits
 
 
 def one_error(capsys, *needles):
@@ -140,3 +149,79 @@ def test_the_default_out_is_held_apart_too(bc_policy, tmp_path, monkeypatch, not
     with pytest.raises(ConfigError, match=r"--out policies/ppo-altitude-c172p lies inside"):
         train_ppo(cfg)
     assert not (tmp_path / "bc/policies").exists()
+
+
+def _scratch(where):
+    return sorted(where.glob("gymfg-ppo-*"))
+
+
+def _kill_when_scratched(argv, tmp):
+    """Start ``train ppo`` with its temp folder in ``tmp``; SIGKILL it (and its env and
+    evaluation processes) once its scratch folder holds a file; the scratch folder."""
+    env = {**os.environ, "TMPDIR": str(tmp), "HF_HUB_OFFLINE": "1", "SDL_VIDEODRIVER": "dummy"}
+    run = subprocess.Popen(
+        [sys.executable, "-m", "gymfg_il.train", *argv],
+        cwd=ROOT,  # this checkout's gymfg_il
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,  # its own process group, killed whole
+    )
+    deadline = time.monotonic() + KILL_DEADLINE_S
+    try:
+        while not any(p.is_file() for d in _scratch(tmp) for p in d.rglob("*")):
+            assert run.poll() is None, run.communicate()[1].decode()[-2000:]
+            assert time.monotonic() < deadline, "the run never wrote to its scratch folder"
+            time.sleep(0.05)  # polls a subprocess's progress: no event to wait on
+    finally:
+        os.killpg(run.pid, signal.SIGKILL)
+        run.communicate()
+    return _scratch(tmp)
+
+
+def test_a_killed_runs_scratch_folder_is_cleared_by_the_next_run(bc_policy, tmp_path, monkeypatch):
+    from gymfg_il.rl.run import train_ppo
+
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    tiny = ["--envs", "1", "--rollout-steps", "64", "--batch-size", "64", "--eval-episodes", "1"]
+    tiny += ["--select-episodes", "1", "--eval-every", "64", "--checkpoints"]
+    argv = ["ppo", "--init", str(bc_policy), "--out", str(tmp_path / "a"), "--steps", "100000"]
+    left = _kill_when_scratched([*argv, *tiny], tmp)
+    assert len(left) == 1 and list(left[0].rglob("*"))  # what the kill leaves, with files in it
+    live = subprocess.Popen(["sleep", "600"])  # a run still going (its pid's process lives)
+    try:
+        kept = [tmp / f"gymfg-ppo-{live.pid}-live", tmp / "gymfg-ppo-others", tmp / "notes"]
+        for folder in kept:
+            folder.mkdir()
+        monkeypatch.setattr(tempfile, "tempdir", str(tmp))  # this process's temp folder
+        cfg = PPORunConfig(
+            init=bc_policy, out=tmp_path / "b", steps=64, envs=1, rollout_steps=64,
+            batch_size=64, eval_episodes=1, select_episodes=1, eval_every=64,
+        )  # fmt: skip
+        train_ppo(cfg)
+        assert (tmp_path / "b/config.json").is_file()
+        assert _scratch(tmp) == sorted(kept[:2]) and kept[2].is_dir()  # the killed run's went
+    finally:
+        live.kill()
+        live.wait()
+
+
+def test_only_the_folders_of_dead_runs_are_cleared(tmp_path):
+    from gymfg_il.rl.folders import clear_killed_runs
+
+    gone = subprocess.Popen(["true"])
+    gone.wait()  # a pid whose process has ended
+    dead = tmp_path / f"gymfg-ppo-{gone.pid}-dead"
+    (dead / "tensorboard").mkdir(parents=True)
+    (dead / "tensorboard/events").write_text("x")
+    target = tmp_path / "elsewhere"
+    target.mkdir()
+    link, file = tmp_path / f"gymfg-ppo-{gone.pid}-link", tmp_path / f"gymfg-ppo-{gone.pid}-file"
+    link.symlink_to(target, target_is_directory=True)
+    file.write_text("not a folder")
+    mine, odd = tmp_path / f"gymfg-ppo-{os.getpid()}-mine", tmp_path / "gymfg-ppo-12x-odd"
+    for folder in (mine, odd):
+        folder.mkdir()
+    assert clear_killed_runs(tmp_path) == [dead]
+    assert sorted(tmp_path.iterdir()) == sorted([target, link, file, mine, odd])
