@@ -194,18 +194,10 @@ class PPORunConfig:
                 f"{self.eval_episodes} (the kept actor is chosen on the curve's seeds and more)"
             )
         problems += self._rollout_problems() + self._seed_problems()
-        if problem := overlap_problem(self.init, self.out):
-            problems.append(problem)
+        problems += filter(None, [overlap_problem(self.init, self.out)])
         if self.sde_every < 0:
             problems.append(f"sde_every={self.sde_every}: want 0 (once a rollout) or more")
-        if not 0 < self.lr < 1:
-            problems.append(f"lr={self.lr} must lie in (0, 1) (default 3e-4)")
-        if self.actor_lr is not None and not 0 < self.actor_lr < 1:
-            problems.append(f"actor_lr={self.actor_lr} must lie in (0, 1)")
-        for name in ("gamma", "gae_lambda"):
-            value = getattr(self, name)
-            if value is not None and not 0 < value <= 1:
-                problems.append(f"{name}={value} must lie in (0, 1]")
+        problems += self._rate_problems()
         if not 0 <= self.average_from < 1:
             problems.append(
                 f"average_from={self.average_from} must lie in [0, 1) (a share of the run)"
@@ -237,6 +229,19 @@ class PPORunConfig:
             raise ConfigError(join_problems("train ppo", problems))
         self.init = None if self.init is None else Path(self.init)
 
+    def _rate_problems(self) -> list[str]:
+        """The learning rates and the discounts out of their ranges."""
+        problems = []
+        if not 0 < self.lr < 1:
+            problems.append(f"lr={self.lr} must lie in (0, 1) (default 3e-4)")
+        if self.actor_lr is not None and not 0 < self.actor_lr < 1:
+            problems.append(f"actor_lr={self.actor_lr} must lie in (0, 1)")
+        for name in ("gamma", "gae_lambda"):
+            value = getattr(self, name)
+            if value is not None and not 0 < value <= 1:
+                problems.append(f"{name}={value} must lie in (0, 1]")
+        return problems
+
     def _seed_problems(self) -> list[str]:
         """Every seed the run takes held to the one seed rule (``typecheck.seed_problem``):
         the envs' (env k starts from seed + k; stable-baselines3 seeds numpy's legacy
@@ -263,7 +268,10 @@ class PPORunConfig:
         if self.envs < 0:
             problems.append(f"envs={self.envs}: want 0 (four per core) or more")
         if self.batch_size < 2:
-            problems.append(f"batch_size={self.batch_size} must be >= 2 (PPO normalises each)")
+            problems.append(
+                f"batch_size={self.batch_size} must be >= 2 (PPO normalises each batch's "
+                "advantages)"
+            )
         if problems or self.rollout_steps < 1:  # rollout_steps: refused with the other counts
             return problems
         envs = f"envs={self.envs}" if self.envs else f"{self.n_envs} envs (four a core)"
