@@ -9,8 +9,9 @@ from pathlib import Path
 from typing import Literal
 
 from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.rl.folders import overlap_problem
 from gymfg_il.sim.weather import Turbulence
-from gymfg_il.typecheck import type_problems
+from gymfg_il.typecheck import SEED_LIMIT, SEED_RULE, seed_problem, type_problems
 
 ANCHOR_SPAN_MAX = 150_000  # the longest the anchor decays over by default (``anchor_steps``)
 # the actor's default learning rate when fine-tuning (``actor_lr``); from scratch it is ``lr``
@@ -72,7 +73,7 @@ class PPORunConfig:
             0.6 MB each; with --keep average the mean too, in OUT/checkpoints/average), to
             fly again (``eval --policy``) or choose on other seeds.
         rollout_steps: steps each env samples between updates (PPO's n_steps).
-        batch_size: samples per gradient step.
+        batch_size: samples per gradient step, a divisor of the rollout (rollout_steps x envs).
         epochs: passes over each rollout per update.
         lr: Adam learning rate of the critic.
         actor_lr: Adam learning rate of the actor (default: 1e-4 when fine-tuning, whatever
@@ -192,20 +193,11 @@ class PPORunConfig:
                 f"select_episodes={self.select_episodes} must be >= eval_episodes="
                 f"{self.eval_episodes} (the kept actor is chosen on the curve's seeds and more)"
             )
-        if self.batch_size < 2:  # PPO normalises each batch's advantages
-            problems.append(f"batch_size={self.batch_size} must be >= 2")
+        problems += self._rollout_problems() + self._seed_problems()
+        problems += filter(None, [overlap_problem(self.init, self.out)])
         if self.sde_every < 0:
             problems.append(f"sde_every={self.sde_every}: want 0 (once a rollout) or more")
-        if self.envs < 0:
-            problems.append(f"envs={self.envs}: want 0 (four per core) or more")
-        if not 0 < self.lr < 1:
-            problems.append(f"lr={self.lr} must lie in (0, 1) (default 3e-4)")
-        if self.actor_lr is not None and not 0 < self.actor_lr < 1:
-            problems.append(f"actor_lr={self.actor_lr} must lie in (0, 1)")
-        for name in ("gamma", "gae_lambda"):
-            value = getattr(self, name)
-            if value is not None and not 0 < value <= 1:
-                problems.append(f"{name}={value} must lie in (0, 1]")
+        problems += self._rate_problems()
         if not 0 <= self.average_from < 1:
             problems.append(
                 f"average_from={self.average_from} must lie in [0, 1) (a share of the run)"
@@ -236,6 +228,68 @@ class PPORunConfig:
         if problems:
             raise ConfigError(join_problems("train ppo", problems))
         self.init = None if self.init is None else Path(self.init)
+
+    def _rate_problems(self) -> list[str]:
+        """The learning rates and the discounts out of their ranges."""
+        problems = []
+        if not 0 < self.lr < 1:
+            problems.append(f"lr={self.lr} must lie in (0, 1) (default 3e-4)")
+        if self.actor_lr is not None and not 0 < self.actor_lr < 1:
+            problems.append(f"actor_lr={self.actor_lr} must lie in (0, 1)")
+        for name in ("gamma", "gae_lambda"):
+            value = getattr(self, name)
+            if value is not None and not 0 < value <= 1:
+                problems.append(f"{name}={value} must lie in (0, 1]")
+        return problems
+
+    def _seed_problems(self) -> list[str]:
+        """Every seed the run takes held to the one seed rule (``typecheck.seed_problem``):
+        the envs' (env k starts from seed + k; stable-baselines3 seeds numpy's legacy
+        generator with ``seed``) and the held-out episodes' (eval_seed + i, up to the last
+        episode the kept actor is chosen on)."""
+        problems = []
+        if problem := seed_problem(self.seed):
+            problems.append(problem)
+        elif self.envs >= 0 and (last := self.seed + self.n_envs - 1) >= SEED_LIMIT:
+            problems.append(
+                f"seed={self.seed}: env {last - self.seed} starts from seed {last}, and a seed "
+                f"is an integer {SEED_RULE}; give --seed {SEED_LIMIT - self.n_envs} or below"
+            )
+        if problem := seed_problem(self.eval_seed, self.chosen_on):
+            problems.append(f"eval_{problem}")  # "seed=...: why" names the flag
+        return problems
+
+    def _rollout_problems(self) -> list[str]:
+        """What stable-baselines3's PPO would stop on (an assertion, after the start's
+        evaluation had flown) or warn of: PPO normalises the advantages of each batch, so a
+        batch holds 2 samples or more, a rollout (rollout_steps x envs) too, and the batches
+        divide the rollout (else each epoch ends on a truncated batch)."""
+        problems = []
+        if self.envs < 0:
+            problems.append(f"envs={self.envs}: want 0 (four per core) or more")
+        if self.batch_size < 2:
+            problems.append(
+                f"batch_size={self.batch_size} must be >= 2 (PPO normalises each batch's "
+                "advantages)"
+            )
+        if problems or self.rollout_steps < 1:  # rollout_steps: refused with the other counts
+            return problems
+        envs = f"envs={self.envs}" if self.envs else f"{self.n_envs} envs (four a core)"
+        rollout = self.rollout
+        if rollout < 2:
+            return [
+                f"rollout_steps={self.rollout_steps} x {envs} is a rollout of {rollout} sample; "
+                "PPO normalises a rollout's advantages, which takes 2 or more: give "
+                "--rollout-steps 2 or more, or --envs 2 or more"
+            ]
+        if rollout % self.batch_size:
+            fits = batch_that_fits(rollout, self.batch_size)
+            return [
+                f"batch_size={self.batch_size} must divide a rollout's {rollout} samples "
+                f"(rollout_steps={self.rollout_steps} x {envs}), or each epoch ends on a "
+                f"truncated batch: give --batch-size {fits}, or a rollout it divides"
+            ]
+        return []
 
     @property
     def n_envs(self) -> int:
@@ -288,3 +342,12 @@ class PPORunConfig:
         if self.anchor_steps is not None:
             return self.anchor_steps
         return min(self.steps // 2, ANCHOR_SPAN_MAX)
+
+
+def batch_that_fits(rollout: int, batch: int) -> int:
+    """The largest batch size of 2 or more, up to ``batch``, that divides ``rollout`` (>= 2),
+    else ``rollout`` itself; of a rollout over 10**12 samples only the divisors found up to
+    a million's pairs are tried (an answer in well under a second)."""
+    small = [d for d in range(1, min(math.isqrt(rollout), 10**6) + 1) if rollout % d == 0]
+    fitting = [d for d in small + [rollout // d for d in small] if 2 <= d <= batch]
+    return max(fitting, default=rollout)

@@ -20,7 +20,6 @@ import logging
 import math
 import os
 import shutil
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -35,6 +34,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 from gymfg_il.errors import ConfigError
 from gymfg_il.rl.config import PPORunConfig
 from gymfg_il.rl.env import make_env
+from gymfg_il.rl.folders import out_folder, scratch_folder
 from gymfg_il.rl.judge import EvalPoint, Judge, choose, plot_curve
 from gymfg_il.rl.policy import AnchoredPolicy
 from gymfg_il.rl.start import Start, as_ppo, meta_of, starting_policy, stats_of
@@ -87,15 +87,13 @@ def _train(
     from stable_baselines3.common.vec_env import VecNormalize
 
     from gymfg_il.learning.config import resolve_device
-    from gymfg_il.policies.checkpoint_folder import check_out
 
     flight, module = start.flight, start.module
-    out = Path(cfg.out or f"policies/ppo-{flight.task}-{flight.aircraft}")
-    check_out(out)  # before training, not after
+    out = out_folder(cfg.out, cfg.init, flight)  # checked before training, not after
     seeds = list(range(cfg.eval_seed, cfg.eval_seed + cfg.eval_episodes))
     more = list(range(seeds[-1] + 1, cfg.eval_seed + cfg.chosen_on))
     began = time.perf_counter()
-    scratch_dir = Path(tempfile.mkdtemp(prefix="gymfg-ppo-"))
+    scratch_dir = scratch_folder()  # removed below; a killed run's, by a later run
     # the evaluations' processes, started before the envs' (the env processes wait while an
     # evaluation flies)
     pool = Workers(min(2, len(os.sched_getaffinity(0)))) if more else Workers(1)

@@ -18,14 +18,6 @@ from gymfg_il.rl.config import PPORunConfig
 pytest.importorskip("stable_baselines3")
 
 
-@pytest.fixture(scope="module")
-def bc_policy(tiny_dataset, tmp_path_factory):
-    """An MLP cloned from the tiny altitude demonstrations (30-s episodes)."""
-    out = tmp_path_factory.mktemp("rl") / "bc"
-    train_bc(TrainConfig(dataset=tiny_dataset, out=out, epochs=3, seed=0))
-    return out
-
-
 def _argv(bc_policy, out, *more):
     """``train ppo``'s command line for ``_short``'s run."""
     return [

@@ -1,0 +1,17 @@
+"""The PPO tests' starting policy: an MLP cloned from the tiny altitude demonstrations."""
+
+from __future__ import annotations
+
+import pytest
+
+
+@pytest.fixture(scope="session")
+def bc_policy(tiny_dataset, tmp_path_factory):
+    """An MLP cloned from the tiny altitude demonstrations (30-s episodes); tests read it,
+    never write it."""
+    from gymfg_il.learning.bc import train_bc
+    from gymfg_il.learning.config import TrainConfig
+
+    out = tmp_path_factory.mktemp("rl") / "bc"
+    train_bc(TrainConfig(dataset=tiny_dataset, out=out, epochs=3, seed=0))
+    return out
