@@ -9,6 +9,7 @@ copy with its CRC (``recording.session.checked``)."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import struct
 from typing import Any
@@ -41,6 +42,7 @@ from gymfg_il.recording.session import (
 )
 
 _U16 = struct.Struct("<H")
+_U32 = struct.Struct("<I")
 _RECORD = struct.Struct("<BQ")
 _CHANNEL_HEAD = struct.Struct("<HHI")
 
@@ -154,15 +156,10 @@ def stream(data: bytes, seen: Sorter, damage: list[Damage]) -> tuple[dict[str, A
     for pos, opcode, body in found:
         if opcode == CHANNEL and (pos < data_end or summary_ok is not False):
             seen.record(opcode, body)
-    for pos, opcode, body in found:
-        if pos >= data_end:
-            break
+    for opcode, body in _in_written_order([f for f in found if f[0] < data_end], damage):
         if opcode == CHUNK:
-            try:
-                seen.chunk(chunk_data(body))
-            except (ValueError, struct.error) as err:
-                damage.append(Damage(pos, pos + 9 + len(body), str(err)))
-        elif opcode in (CHANNEL, MESSAGE):
+            seen.chunk(body)
+        else:
             seen.record(opcode, body)
     if data_ok is False and not any(d.start < data_end for d in damage):
         damage.append(
@@ -174,6 +171,54 @@ def stream(data: bytes, seen: Sorter, damage: list[Damage]) -> tuple[dict[str, A
             )
         )
     return session, finished
+
+
+def _in_written_order(
+    found: list[tuple[int, int, memoryview]], damage: list[Damage]
+) -> list[tuple[int, Any]]:
+    """The data section's chunks (decompressed and checked) and loose channel and message
+    records, in the order they were written: by the sequence number of their first message
+    (a chunk copied twice is read once; chunks moved out of order are put back)."""
+    items: list[tuple[int, int, int, Any]] = []  # (sequence, position, opcode, body)
+    copies: set[bytes] = set()
+    last = -1
+    for pos, opcode, body in found:
+        end = pos + 9 + len(body)
+        if opcode == CHUNK:
+            try:
+                inner = chunk_data(body)
+            except (ValueError, struct.error) as err:
+                damage.append(Damage(pos, end, str(err)))
+                continue
+            fingerprint = hashlib.blake2b(inner, digest_size=16).digest()
+            if fingerprint in copies:
+                damage.append(Damage(pos, end, "a copy of an earlier chunk; read once"))
+                continue
+            copies.add(fingerprint)
+            last = _first_sequence(inner, last)
+            items.append((last, pos, opcode, inner))
+        elif opcode in (CHANNEL, MESSAGE):  # a channel stays after what precedes it
+            last = _U32.unpack_from(body, 2)[0] if opcode == MESSAGE else last
+            items.append((last, pos, opcode, body))
+    ordered = sorted(items, key=lambda item: item[:2])
+    moved = [a[1] for a, b in zip(ordered, items, strict=True) if a[1] != b[1]]
+    if moved:
+        damage.append(
+            Damage(min(moved), max(moved), "chunks out of the order they were written; reordered")
+        )
+    return [(opcode, body) for _, _, opcode, body in ordered]
+
+
+def _first_sequence(records: bytes, default: int) -> int:
+    """The sequence number of the first message among a chunk's ``records`` (``default``
+    where it holds none)."""
+    pos = 0
+    while pos + 9 <= len(records):
+        opcode, length = _RECORD.unpack_from(records, pos)
+        if opcode == MESSAGE:
+            return int(_U32.unpack_from(records, pos + 9 + 2)[0])
+        pos += 9 + length
+    return default
 
 
 def _session(maps: list[tuple[int, int, str, dict[str, str]]], damage: list[Damage]) -> Any:

@@ -189,3 +189,54 @@ def test_no_single_flipped_byte_outside_the_chunks_loses_the_whole_log(session, 
         log = read_log(broken)  # never "the session record is lost"
         assert {e.index for e in log.complete_episodes} >= spared, offset
         assert log.damage, offset
+
+
+def _same_episodes(log, original):
+    kept = {e.index: e for e in log.complete_episodes}
+    assert set(kept) == {e.index for e in original.complete_episodes}
+    for ep in original.complete_episodes:
+        a, b = kept[ep.index].steps["ego"], ep.steps["ego"]
+        assert np.array_equal(a.state, b.state) and np.array_equal(a.label, b.label)
+
+
+@pytest.mark.parametrize("how", ["duplicated", "swapped"])
+def test_chunks_copied_or_moved_with_their_bytes_intact_lose_nothing(session, tmp_path, how):
+    """#52.12: a chunk written twice, or two chunks swapped, each with its bytes intact, lost
+    that chunk's episode (its steps read twice or out of order); now every episode is read
+    as it was written, and the log says what was done to it."""
+    _, path = session
+    data = path.read_bytes()
+    chunks = _chunks(data)
+    assert len(chunks) >= 4
+    (a, a_end), (b, b_end) = chunks[1], chunks[2]
+    if how == "duplicated":
+        bad = data[:a_end] + data[a:a_end] + data[a_end:]
+    else:
+        bad = data[:a] + data[b:b_end] + data[a:a_end] + data[b_end:]
+    broken = tmp_path / "broken.mcap"
+    broken.write_bytes(bad)
+    log = read_log(broken)
+    _same_episodes(log, read_log(path))
+    said = "a copy of an earlier chunk" if how == "duplicated" else "out of the order"
+    assert any(said in note for note in log.damage), log.damage
+
+
+def test_replay_says_when_there_is_nothing_to_replay_or_the_file_is_cut(
+    session, tmp_path, capsys
+):
+    """#52.6: `replay` of a folder whose only log is empty exited 0, and a log cut in half
+    replayed with no word that it was."""
+    empty = tmp_path / "empty"
+    (empty / "logs").mkdir(parents=True)
+    (empty / "logs" / "a.mcap").write_bytes(b"")
+    assert collect.main(["replay", str(empty)]) == 2
+    assert "nothing to replay" in capsys.readouterr().err
+    _, path = session
+    data = path.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) // 2])
+    assert collect.main(["replay", str(cut)]) == 0  # what it holds replays identically
+    said = capsys.readouterr()
+    assert "identical" in said.out and "DIFFERS" not in said.out
+    assert "cut.mcap: the file ends before its footer" in said.err
+    assert "2 completed episode(s) in it" in said.err  # of 4: the rest is cut off
