@@ -129,6 +129,20 @@ def report_build(report: BuildReport, root: Path, moved: dict[Path, Path] | None
         print(f"set aside {path.name} as {target.name} (not deleted)", file=sys.stderr)
 
 
+def _say_unfinished(lg: Log) -> None:
+    """A log without its footer ends where its writer stopped: a session killed mid-write,
+    or a file cut short. Say so, and what of it is left out."""
+    if lg.finished:
+        return
+    cut = [e.index for e in lg.episodes if not e.complete and not e.discarded]
+    print(
+        f"{lg.path.name}: the file ends before its footer (a session killed mid-write, or "
+        f"the file cut short); {len(lg.complete_episodes)} completed episode(s) in it"
+        + (f", episode {cut[-1]} incomplete and left out" if cut else ""),
+        file=sys.stderr,
+    )
+
+
 def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
     """Re-fly every completed episode of the log(s) at ``target``; 1 if any differs."""
     paths = sorted((target / LOGS).glob("*.mcap")) if target.is_dir() else [target]
@@ -152,6 +166,9 @@ def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
         for note in lg.damage:
             print(f"{lg.path.name}: could not read {note}", file=sys.stderr)
             failures += 1
+        _say_unfinished(lg)
+    if not any(lg.complete_episodes for lg in logs):
+        raise ConfigError(f"nothing to replay: no log at {target} holds a completed episode")
     if episode is not None and not any(
         e.index == episode for lg in logs for e in lg.complete_episodes
     ):
@@ -175,6 +192,25 @@ def replay(target: Path, episode: int | None, views: Sequence[int] = ()) -> int:
                 print(f"  largest |difference| {r.max_abs_diff:.3g}")
             failures += not r.identical
     return 1 if failures else 0
+
+
+def _report_matched(report: BuildReport, root: Path) -> None:
+    """Say which dataset episodes had lost their records but are logged episodes by their
+    frames (a dataset edited with LeRobot's tools), and what recover added back to it."""
+    if not report.matched:
+        return
+    print(
+        f"{len(report.matched)} dataset episode(s) record no log (LeRobot's dataset editing "
+        "drops the gymfg/* records) but hold the frames of logged episodes, so they are "
+        "kept as those episodes; give them their records back with python -m "
+        f"gymfg_il.collect repair {root} --source ORIGINAL"
+    )
+    if report.added:
+        print(
+            f"the {report.added} logged episode(s) the dataset lacked were added back (recover "
+            "keeps every completed episode of the logs; to train without some, use train bc "
+            "--select, or mark them when you fly)"
+        )
 
 
 def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
@@ -203,7 +239,11 @@ def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
     ]
     if report.rebuilt:  # set aside: what it held that no log names is gone
         lost += [(i, None) for i in unnamed]
-    kept = [(i, ref) for i, ref in after if ref is None or ref not in report.logged]
+    # what no log holds: by the record it names, else by its frames (what this build added
+    # came from the logs, also where the dataset keeps no records)
+    logged = {*report.matched, *range(report.total_episodes - report.added, report.total_episodes)}
+    kept = [(i, ref) for i, ref in after if ref not in report.logged and i not in logged]
+    _report_matched(report, root)
     named = []
     for title, rows in (
         ("are lost: no log under {logs} holds them", lost),

@@ -63,6 +63,9 @@ class BuildReport:
     unreadable: list[Unreadable] = field(default_factory=list)  # files that are no log
     differences: list[str] = field(default_factory=list)  # why the old dataset was set aside
     aside: Path | None = None  # where it was kept
+    # dataset episodes that name no log (LeRobot's editing drops the records) but hold the
+    # frames of a log episode: dataset index -> that episode
+    matched: dict[int, EpisodeRef] = field(default_factory=dict)
 
 
 def _clean_leftovers(root: Path) -> None:
@@ -265,6 +268,7 @@ def _build(
     _clean_leftovers(root)
     for name, pairs in twins.items():
         outcomes[name].left_out += _twin_lines(pairs)
+    matched = {t: ref for pairs in twins.values() for ref, t in pairs if isinstance(t, int)}
     skipped = sum(1 for lg in logs for e in lg.episodes if not e.complete and not e.discarded)
     damage = [f"{lg.path.name}: {note}" for lg in logs for note in lg.damage]
     damage += [f"{u.path.name}: not read: {u.why}" for u in unreadable]
@@ -282,6 +286,7 @@ def _build(
         unreadable,
         found,
         aside,
+        matched,
     )
 
 

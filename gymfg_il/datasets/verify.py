@@ -43,27 +43,37 @@ def digest(state: np.ndarray, action: np.ndarray) -> str:
 
 
 def _column(table: Any, name: str) -> np.ndarray:
-    """A column as numpy: fixed-size lists as (rows, width)."""
+    """A column as numpy: lists of one length (a fixed-size list, or the plain lists that
+    LeRobot's own editing writes) as (rows, width); ValueError for lists of other lengths."""
     import pyarrow as pa
+    import pyarrow.compute as pc
 
     column = table[name].combine_chunks()
     if pa.types.is_fixed_size_list(column.type):
         width = column.type.list_size
+        return column.flatten().to_numpy(zero_copy_only=False).reshape(-1, width)
+    if pa.types.is_list(column.type) or pa.types.is_large_list(column.type):
+        lengths = pc.list_value_length(column).to_numpy(zero_copy_only=False)
+        if len(column) and (column.null_count or (lengths != lengths[0]).any()):
+            raise ValueError(f"its {name} column holds vectors of different lengths")
+        width = int(lengths[0]) if len(column) else 0
         return column.flatten().to_numpy(zero_copy_only=False).reshape(-1, width)
     return column.to_numpy(zero_copy_only=False)
 
 
 def _frames(root: Path, features: Mapping[str, Any]) -> tuple[dict[str, np.ndarray], list[str]]:
     """Every data file's non-video columns, concatenated; and what could not be read."""
-    import pyarrow as pa
 
     names = [k for k, f in features.items() if f.get("dtype") != "video"]
     names += [k for k in _BOOKKEEPING if k not in names]
     tables, problems = _read(root, names)
     if problems or not tables:
         return {}, problems or ["data/ holds no data files"]
-    table = pa.concat_tables(tables)
-    return {name: _column(table, name) for name in table.column_names}, []
+    try:  # file by file: LeRobot's editing writes plain lists where ours are fixed-size
+        parts = [{name: _column(t, name) for name in t.column_names} for t in tables]
+        return {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}, []
+    except ValueError as err:
+        return {}, [f"data/: {err}"]
 
 
 def page_problems(root: Path, features: Mapping[str, Any]) -> list[str]:

@@ -252,3 +252,49 @@ def test_a_mark_given_after_the_build_is_taken_in_place(copy, capsys):
     assert "rebuilt" not in capsys.readouterr().out
     assert records(copy / "dataset") == truth
     assert not list(copy.glob("dataset.broken-*"))
+
+
+def test_a_lerobot_merge_of_two_sessions_recovers_from_both_logs(session, tmp_path, capsys):
+    """#52.11: LeRobot's merge_datasets output (plain list columns, not fixed-size ones) in
+    a session folder holding both sessions' logs: recover died in verify.digest (ValueError).
+    Its frames and records are the logs', so it is kept as it is."""
+    from lerobot.datasets.dataset_tools import merge_datasets
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    first, _ = session
+    cfg = CollectConfig(task="roll", episodes=2, episode_time_s=6, seed=50, out=tmp_path / "b")
+    collect_autopilot(cfg)
+    parts = [
+        LeRobotDataset(f"gymfg/{k}", root=f / "dataset") for k, f in enumerate([first, cfg.out])
+    ]
+    merged = tmp_path / "m"
+    merge_datasets(parts, output_repo_id="gymfg/m", output_dir=merged / "dataset")
+    (merged / "logs").mkdir()
+    for folder in (first, cfg.out):
+        for log in (folder / "logs").glob("*.mcap"):
+            shutil.copy(log, merged / "logs" / log.name)
+    capsys.readouterr()
+    assert collect.main(["recover", str(merged)]) == 0
+    out = capsys.readouterr().out
+    assert f"{EPISODES + 2} episodes (+0" in out and "rebuilt" not in out
+
+
+def test_after_lerobots_delete_episodes_recover_says_what_it_did(copy, capsys):
+    """#52.12: after `lerobot-edit-dataset delete_episodes` (which drops the gymfg/* records)
+    recover added the deleted episode back and said both that the logs gave the same episodes
+    as the dataset's and that no log held the dataset's episodes. Now the edited episodes are
+    known by their frames, and the episode it adds back is said to be added back."""
+    from lerobot.datasets.dataset_tools import delete_episodes
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    edited = copy / "edited"
+    delete_episodes(LeRobotDataset("gymfg/s", root=copy / "dataset"), [0], output_dir=edited)
+    shutil.rmtree(copy / "dataset")
+    edited.rename(copy / "dataset")
+    capsys.readouterr()
+    assert collect.main(["recover", str(copy)]) == 0
+    said = capsys.readouterr()
+    assert f"{EPISODES} episodes (+1" in said.out
+    assert f"{EPISODES - 1} dataset episode(s) record no log" in said.out
+    assert "added back" in said.out and "collect repair" in said.out
+    assert "no log" not in said.err
