@@ -161,8 +161,9 @@ def build(cls: type, ns: argparse.Namespace, **extra: Any) -> Any:
 
 
 def run(main: Callable[[], int]) -> int:
-    """Run an entry point: a project error is one line on stderr and exit status 2."""
-    from gymfg_il.errors import GymFGError
+    """Run an entry point: a project error, or a full disk, is one line on stderr and exit
+    status 2."""
+    from gymfg_il.errors import GymFGError, disk_full
 
     try:
         return main()
@@ -172,6 +173,18 @@ def run(main: Callable[[], int]) -> int:
     except BrokenPipeError:  # the reader went away (``| head``): stop quietly, as cat does
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no flush error at exit
         return 1
+    except Exception as err:
+        where = disk_full(err)
+        if where is None:
+            raise
+        print(
+            f"error: the disk is full ({where}): free some space and run the command again; "
+            "what was saved before stays as it was (a policy is replaced only once the new one "
+            "is whole; a session's completed episodes are in its logs: python -m "
+            "gymfg_il.collect recover SESSION)",
+            file=sys.stderr,
+        )
+        return 2
 
 
 def progress_bar(total: int, desc: str, unit: str, enabled: bool = True) -> Any:

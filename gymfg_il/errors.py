@@ -45,3 +45,24 @@ class MixedTasksError(ConfigError):
 class UntrustedTaskError(ConfigError):
     """A record read from a file names a task by import path whose module nobody imported:
     building it would run code the file chose."""
+
+
+# what the libraries under GymFG say when the disk is full: OSError's errno (ENOSPC, EDQUOT),
+# or only in their text (safetensors' SafetensorError, pyarrow's and torch's messages)
+_FULL_ERRNOS = (28, 122)
+_FULL_TEXTS = ("No space left on device", "StorageFull", "os error 28", "Disk quota exceeded")
+
+
+def disk_full(err: BaseException) -> str | None:
+    """Where ``err`` (or what caused it) says the disk is full: the file or the message;
+    None when it says nothing of the kind."""
+    seen: set[int] = set()
+    found: BaseException | None = err
+    while found is not None and id(found) not in seen:
+        seen.add(id(found))
+        if isinstance(found, OSError) and found.errno in _FULL_ERRNOS:
+            return str(found.filename or found.strerror)
+        if any(text in str(found) for text in _FULL_TEXTS):
+            return str(found).splitlines()[0][:200] if str(found) else type(found).__name__
+        found = found.__cause__ or found.__context__
+    return None

@@ -243,9 +243,17 @@ def load_frames(root: Path, camera: str | None = None) -> Frames:
     if not (root / "meta").is_dir() and (root / "dataset" / "meta").is_dir():
         root = root / "dataset"  # a session folder: its dataset is inside
     if not (root / "meta" / "info.json").is_file():
+        session = next((f for f in (root, root.parent) if any(f.glob("logs/*.mcap"))), None)
         raise ConfigError(
-            f"no LeRobot dataset at {root} (no meta/info.json); collect one with "
-            "`python -m gymfg_il.collect autopilot --out DIR` and pass DIR/dataset"
+            f"no LeRobot dataset at {root} (no meta/info.json); "
+            + (
+                f"its session's logs are in {session / 'logs'} (a session killed before its "
+                f"dataset was written?): build it with python -m gymfg_il.collect recover "
+                f"{session}"
+                if session is not None
+                else "collect one with `python -m gymfg_il.collect autopilot --out DIR` and "
+                "pass DIR/dataset"
+            )
         )
     problems = meta_problems(root) or dataset_problems(root)
     if problems:

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.errors import ConfigError
+from gymfg_il.errors import ConfigError, disk_full
 
 
 class DivergedError(ConfigError):
@@ -58,8 +58,10 @@ def save_run(
             text = json.dumps({"train_loss": train, "val_loss": val}, indent=1)
             (folder / "train_log.json").write_text(text)
     except OSError as err:
+        if disk_full(err):
+            raise  # the entry point says so in one line
         raise ConfigError(
-            f"cannot save the policy to {out} ({err}); free some space or give another --out"
+            f"cannot save the policy to {out} ({err.strerror or err}); give another --out"
         ) from None
 
 
