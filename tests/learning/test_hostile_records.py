@@ -149,3 +149,18 @@ def test_a_flipped_data_page_that_reads_as_numbers_is_refused(tmp_path, capsys):
     assert code == 2
     one_error(capsys, "action column cannot be read", "collect recover")
     assert not out.exists()
+
+
+def test_a_session_killed_before_its_dataset_points_to_recover(tmp_path, capsys):
+    """#52.12: train bc on a session whose dataset was never written (killed) said "collect
+    one" although its logs hold the episodes."""
+    from gymfg_il.collectors.autopilot import collect_autopilot
+    from gymfg_il.collectors.config import CollectConfig
+
+    cfg = CollectConfig(task="altitude", episodes=1, episode_time_s=4, out=tmp_path / "s")
+    collect_autopilot(cfg)
+    shutil.rmtree(tmp_path / "s" / "dataset")
+    code, out = bc(tmp_path, tmp_path / "s")
+    assert code == 2
+    one_error(capsys, "collect recover", str(tmp_path / "s"))
+    assert not out.exists()
