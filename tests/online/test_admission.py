@@ -177,20 +177,23 @@ class Squatter(threading.Thread):
 
 
 SQUATS = {
-    # mode, server options, the squatter's team, token and callsigns, the refusal red meets
+    # mode, server options, the squatter's team, token and callsigns, the refusal red meets.
+    # A team of a shared secret has no name of its own (anyone with the secret may join under
+    # it), nor callsigns; a team with its own secret has both, and only its own clients can
+    # hold them (test_security: no other team may take them)
     "open: another team's callsigns": (
-        ["--mode", "open", "--team", "red:r", "--team", "mal:m"],
-        ("mal", "m", ["red-1"]),
+        ["--mode", "open", "--secret", "r"],
+        ("mal", "r", ["red-1"]),
         "taken by other teams",
     ),
     "open, pausing: another team's callsigns": (
-        ["--mode", "open", "--on-stall", "pause", "--team", "red:r", "--team", "mal:m"],
-        ("mal", "m", ["red-1"]),
+        ["--mode", "open", "--on-stall", "pause", "--secret", "r"],
+        ("mal", "r", ["red-1"]),
         "taken by other teams",
     ),
     "open, ending: another team's callsigns": (
-        ["--mode", "open", "--on-stall", "end", "--team", "red:r", "--team", "mal:m"],
-        ("mal", "m", ["red-1"]),
+        ["--mode", "open", "--on-stall", "end", "--secret", "r"],
+        ("mal", "r", ["red-1"]),
         "taken by other teams",
     ),
     "open, shared secret: another team's name": (
@@ -198,9 +201,14 @@ SQUATS = {
         ("red", "r", ["mal-1"]),
         "already connected",
     ),
+    "open, own secrets: another client of the team": (
+        ["--mode", "open", "--team", "red:r", "--team", "mal:m"],
+        ("red", "r", ["red-2"]),
+        "already connected",
+    ),
     "fixed, before the start: another team's callsigns": (
-        ["--mode", "fixed", "--teams", "2", "--team", "red:r", "--team", "mal:m"],
-        ("mal", "m", ["red-1"]),
+        ["--mode", "fixed", "--teams", "2", "--secret", "r"],
+        ("mal", "r", ["red-1"]),
         "taken by other teams",
     ),
 }
