@@ -190,11 +190,12 @@ class Roster:
                 f"this server holds {self.max_teams} teams at most and has them all; try again "
                 "later",
             )
-        taken = [c for c in callsigns if c in self.owner]
+        taken = [repr(c) for c in callsigns if c in self.owner]
         if taken:
             raise Refused(
                 "duplicate",
-                f"callsigns {taken} are taken by other teams; callsigns are unique in a simulation",
+                f"callsigns {_some(taken)} are taken by other teams; callsigns are unique in a "
+                "simulation",
             )
         record = TeamRecord(name, identity, token, callsigns)
         record.row_bytes = rows_bytes(name, callsigns, self.view_width)
