@@ -30,7 +30,8 @@ def main(argv: list[str] | None = None) -> int:
         action="append",
         default=[],
         metavar="NAME:SECRET",
-        help="a per-team secret (repeatable); wins over --secret for that team",
+        help="a per-team secret (repeatable); wins over --secret for that team, whose "
+        "callsigns are then its own: NAME, or NAME then anything but a letter (NAME-1)",
     )
     p.add_argument(
         "--seconds", type=float, help="stop after this long (default: run until interrupted)"

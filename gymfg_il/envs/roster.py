@@ -16,7 +16,8 @@ from gymfg_il.errors import ConfigError, UntrustedTaskError
 from gymfg_il.names import check_name
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.tasks.base import Task
-from gymfg_il.tasks.library import TASK_FAMILIES, record_task_problem, task_class
+from gymfg_il.tasks.library import TASK_FAMILIES, task_class
+from gymfg_il.tasks.paths import record_task_problem
 
 UNBUILDABLE = "python:"  # marks a recorded value that cannot be rebuilt from the record
 

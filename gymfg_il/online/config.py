@@ -35,7 +35,9 @@ class ServerConfig:
         bind: address to listen on; loopback unless told otherwise.
         port: TCP port (0 picks a free one).
         secrets: team -> secret; a team not listed needs ``shared_secret``. Team names
-            follow ``gymfg_il.names`` (printable, 1 to 64 characters).
+            follow ``gymfg_il.names`` (printable, 1 to 64 characters). A listed team's
+            callsigns are named after it, and no other team may take them
+            (``online.roster``).
         shared_secret: one secret every team must present ("" and no per-team secrets = no
             authentication).
         timeout_s: seconds of silence after which a team is dropped (its name and callsigns

@@ -11,6 +11,14 @@ Rules the server relies on:
   longer flying (finished) and have been silent for the stall timeout make room, oldest
   first; otherwise the join is refused as full. A join that would let some team's central
   state outgrow what a client accepts (``online.sizes``) is refused as too large.
+- Callsigns of a team with its own secret (``--team NAME:SECRET``) are that team's: a
+  callsign belongs to the listed team whose name it is, or begins with, followed by anything
+  but a letter (team ``red``: ``red``, ``red-1``, ``red2``, ``red lead``; not ``reddish``;
+  where two listed names fit, the longer: ``red-team-1`` is team ``red-team``'s). No other
+  team may join with it, and such a team joins with its own callsigns only, so a team with
+  its own secret can never be locked out by another holding its callsigns. A team of the
+  shared secret or of a server without secrets has no name of its own (anyone with the
+  secret may join under it), and its callsigns are first come, first served.
 - Holding: a team holds its name and callsigns only while it is connected and reporting. A
   team is silent when it owes the server a report (it has its reply, or has just joined) or
   an answer to a ``wait`` (the server tells waiting teams why they wait, and they answer
@@ -92,6 +100,7 @@ class Roster:
         view_width: int = 6,
     ) -> None:
         self.secrets, self.shared_secret = dict(secrets), shared_secret
+        self.name_lengths = sorted({len(n) for n in self.secrets}, reverse=True)
         self.max_teams, self.fixed_teams, self.away_s = max_teams, fixed_teams, away_s
         self.view_width = view_width
         self.teams: dict[str, TeamRecord] = {}
@@ -123,9 +132,39 @@ class Roster:
             )
         raise Refused("unauthorised", f"team {team!r}: wrong or missing token")
 
+    def reserved_for(self, callsign: str) -> str | None:
+        """The team with its own secret that ``callsign`` belongs to (module docstring), or
+        None: no team's."""
+        for end in self.name_lengths:  # longest first
+            if callsign[:end] in self.secrets and not callsign[end : end + 1].isalpha():
+                return callsign[:end]
+        return None
+
+    def check_callsigns(self, name: str, callsigns: list[str]) -> None:
+        """Refuse (``forbidden``) a join with another team's callsigns, or, from a team with
+        its own secret, with callsigns not named after it."""
+        owners = {c: self.reserved_for(c) for c in callsigns}
+        foreign = [f"{c!r} (of team {o!r})" for c, o in owners.items() if o not in (None, name)]
+        if foreign:
+            yours = f"after your own, e.g. {name + '-1'!r}" if name in self.secrets else "otherwise"
+            raise Refused(
+                "forbidden",
+                f"team {name!r} may not fly {_some(foreign)}: a callsign named after a team "
+                f"with its own secret is that team's; name your aircraft {yours}",
+            )
+        strays = [repr(c) for c, o in owners.items() if o is None and name in self.secrets]
+        if strays:
+            raise Refused(
+                "forbidden",
+                f"team {name!r} has its own secret, so its callsigns are named after it (its "
+                f"name, or its name then anything but a letter: {name + '-1'!r}, "
+                f"{name + ' lead'!r}), and no other team may take them: rename {_some(strays)}",
+            )
+
     def join(self, identity: bytes, name: str, token: str, callsigns: list[str]) -> TeamRecord:
         """Admit (or readmit) a team; Refused says why not."""
         self.check_token(name, token)
+        self.check_callsigns(name, callsigns)
         known = self.teams.get(name)
         if known is not None:
             if known.active and known.identity != identity:
@@ -151,11 +190,12 @@ class Roster:
                 f"this server holds {self.max_teams} teams at most and has them all; try again "
                 "later",
             )
-        taken = [c for c in callsigns if c in self.owner]
+        taken = [repr(c) for c in callsigns if c in self.owner]
         if taken:
             raise Refused(
                 "duplicate",
-                f"callsigns {taken} are taken by other teams; callsigns are unique in a simulation",
+                f"callsigns {_some(taken)} are taken by other teams; callsigns are unique in a "
+                "simulation",
             )
         record = TeamRecord(name, identity, token, callsigns)
         record.row_bytes = rows_bytes(name, callsigns, self.view_width)
@@ -192,3 +232,10 @@ class Roster:
     def clear(self) -> None:
         self.teams.clear()
         self.owner.clear()
+
+
+def _some(items: list[str], shown: int = 3) -> str:
+    """The first few of ``items``, and how many more (a refusal names a few of 64 callsigns
+    of 64 characters, and stays within what a client accepts: ``protocol.MAX_TEXT``)."""
+    more = f" (and {len(items) - shown} more)" if len(items) > shown else ""
+    return ", ".join(items[:shown]) + more

@@ -1,7 +1,8 @@
 """Tasks: each aircraft's observation, reward, termination and start state.
 
 Submodules: ``base`` (Task), ``targets`` (static/dynamic target machinery), ``library`` (the
-named tasks), ``rewards`` (RewardContext and shaping), ``geometry``, ``orientation`` and
+named tasks), ``paths`` (tasks of your own named by import path, and the trust a record needs
+to name one), ``rewards`` (RewardContext and shaping), ``geometry``, ``orientation`` and
 ``state`` (the state-variable catalogue and StateView).
 """
 

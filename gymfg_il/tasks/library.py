@@ -20,16 +20,14 @@ it ``truncated``. The action is ``[aileron, elevator, rudder, throttle]``.
 
 from __future__ import annotations
 
-import importlib
 import math
-import os
-import sys
 from typing import Any
 
 import numpy as np
 
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.paths import import_task
 from gymfg_il.tasks.rewards import RewardContext, action_change
 from gymfg_il.tasks.targets import (
     AIRSPEED,
@@ -270,7 +268,7 @@ def task_class(name: str, dynamic: bool = False) -> type[Task]:
     from gymfg_il.errors import ConfigError
 
     if isinstance(name, str) and ":" in name:
-        return _import_task(name)
+        return import_task(name)
     name = TASK_ALIASES.get(name, name) if isinstance(name, str) else name
     try:
         static, moving = TASK_FAMILIES[name]
@@ -282,46 +280,6 @@ def task_class(name: str, dynamic: bool = False) -> type[Task]:
     if dynamic and static is moving:
         raise ConfigError(f"task {name!r} has no dynamic variant; drop --dynamic")
     return moving if dynamic else static
-
-
-def _import_task(path: str) -> type[Task]:
-    from gymfg_il.errors import ConfigError
-
-    module, _, qualname = path.partition(":")
-    try:
-        found: Any = importlib.import_module(module)
-        for part in qualname.split("."):
-            found = getattr(found, part)
-    except (ImportError, AttributeError) as err:
-        raise ConfigError(
-            f"cannot import task {path!r} ({err}); is its package installed?"
-        ) from None
-    if not (isinstance(found, type) and issubclass(found, Task)):
-        raise ConfigError(f"{path!r} is {found!r}, not a Task class")
-    return found
-
-
-TRUSTED_MODULES_ENV = "GYMFG_TASK_MODULES"
-
-
-def record_task_problem(name: object) -> str | None:
-    """Why the task ``name`` read from a record (a dataset, a log, a checkpoint: a file from
-    outside) may not be built, or None. A library family is always fine; an import path
-    ``package.module:ClassName`` is fine only when its module is imported already (the user's
-    own code did it, or gave it as ``--task``) or is listed in ``$GYMFG_TASK_MODULES``
-    (comma-separated): a file must never make GymFG import the code it names."""
-    if not isinstance(name, str) or ":" not in name:
-        return None
-    module = name.partition(":")[0]
-    trusted = {m.strip() for m in os.environ.get(TRUSTED_MODULES_ENV, "").split(",")}
-    if module in sys.modules or module in trusted:
-        return None
-    return (
-        f"the record names task {name!r}, whose module {module!r} is not imported; a dataset, "
-        "log or checkpoint may not make GymFG import code. If you trust that module, import "
-        f"it first (give --task {name}, or import it in your script) or set "
-        f"{TRUSTED_MODULES_ENV}={module}"
-    )
 
 
 def task_reference(cls: type[Task]) -> tuple[str, bool]:

@@ -404,3 +404,69 @@ def test_without_an_atomic_exchange_the_old_policy_is_renamed_aside_and_back(
         (folder / "config.json").write_text("{}")
     assert policy_files(tmp_path / "p") == {"config.json": b"{}"}
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p"]
+
+
+# --- a record naming a task that cannot be built (red team #52.8) -------------------------
+
+UNFLYABLE = [":AltitudeTask", "__main__:AltitudeTask", "gymfg_il.tasks.base:Task"]
+
+
+def name_task(root, task):
+    """The dataset at ``root`` with every episode's flight spec naming ``task``."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = episodes_table(root)
+    table = pq.read_table(path)
+    specs = []
+    for text in table.column("gymfg/spec").to_pylist():
+        spec = json.loads(text)
+        spec["teams"][0]["roster"][0]["task"] = task
+        specs.append(json.dumps(spec))
+    at = table.schema.get_field_index("gymfg/spec")
+    pq.write_table(table.set_column(at, table.schema.field(at), pa.array(specs)), path)
+
+
+@pytest.mark.parametrize("task", UNFLYABLE)
+def test_train_refuses_a_dataset_naming_a_task_that_cannot_fly(tmp_path, capsys, task):
+    root = damaged(tmp_path, lambda r: name_task(r, task))
+    code, out = bc(tmp_path, "--dataset", str(root))
+    assert code == 2
+    printed = capsys.readouterr()
+    # refused before training (it prints "training N epoch(s)" first), in one line
+    assert printed.err.startswith("error: ") and printed.err.count("\n") == 1, printed.err
+    assert not printed.out
+    assert "Traceback" not in printed.err and repr(task) in printed.err
+    assert not out.exists()
+
+
+def unflyable_policy(old_policy, tmp_path, task):
+    """A copy of a trained policy whose config.json names ``task``."""
+    folder = tmp_path / "unflyable"
+    shutil.copytree(old_policy, folder)
+
+    def change(config):
+        config["task"] = config["spec"]["teams"][0]["roster"][0]["task"] = task
+
+    edit_json(folder / "config.json", change)
+    return folder
+
+
+@pytest.mark.parametrize("task", [":AltitudeTask", "gymfg_il.tasks.base:Task"])
+@pytest.mark.parametrize("entry", ["eval", "ppo --init", "collect dagger"])
+def test_flying_a_policy_that_names_a_task_that_cannot_fly_is_one_line(
+    old_policy, tmp_path, capsys, entry, task
+):
+    from gymfg_il import collect
+
+    policy = str(unflyable_policy(old_policy, tmp_path, task))
+    out = str(tmp_path / "out")
+    code = {
+        "eval": lambda: evaluate.main(["--policy", policy, "--episodes", "1", "--no-progress"]),
+        "ppo --init": lambda: train.main(["ppo", "--init", policy, "--steps", "64", "--out", out]),
+        "collect dagger": lambda: collect.main(
+            ["dagger", "--policy", policy, "--out", out, "--iterations", "1", "--episodes", "1"]
+        ),
+    }[entry]()
+    assert code == 2
+    one_error(capsys, repr(task))

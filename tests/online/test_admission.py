@@ -136,6 +136,22 @@ def test_a_central_state_never_outgrows_what_a_client_accepts(serve, zmq_ctx):
             sock.close(0)
 
 
+def test_a_refusal_naming_many_long_callsigns_stays_within_what_a_client_accepts(serve, zmq_ctx):
+    """64 taken callsigns of 64 characters made a refusal of over 4096 characters, which the
+    client refused as malformed instead of saying why it was turned down."""
+    address, *_ = serve("--mode", "open")
+    callsigns = [f"{i}".rjust(64, "c") for i in range(64)]
+    first, second = dealer(zmq_ctx, address), dealer(zmq_ctx, address)
+    try:
+        assert join(first, "a", dict.fromkeys(callsigns, "c172p"))["type"] == "welcome"
+        reply = join(second, "b", dict.fromkeys(callsigns, "c172p"))  # decoded as a client does
+        assert reply["code"] == "duplicate" and "taken by other teams" in reply["message"]
+        assert repr(callsigns[0]) in reply["message"] and "(and 61 more)" in reply["message"]
+    finally:
+        first.close(0)
+        second.close(0)
+
+
 class Squatter(threading.Thread):
     """A team that joins as ``team`` with ``callsigns``, reports, and keeps reporting (and
     answering the server's waits) until ``leave_silently()``: then it falls silent with its
@@ -177,20 +193,23 @@ class Squatter(threading.Thread):
 
 
 SQUATS = {
-    # mode, server options, the squatter's team, token and callsigns, the refusal red meets
+    # mode, server options, the squatter's team, token and callsigns, the refusal red meets.
+    # A team of a shared secret has no name of its own (anyone with the secret may join under
+    # it), nor callsigns; a team with its own secret has both, and only its own clients can
+    # hold them (test_security: no other team may take them)
     "open: another team's callsigns": (
-        ["--mode", "open", "--team", "red:r", "--team", "mal:m"],
-        ("mal", "m", ["red-1"]),
+        ["--mode", "open", "--secret", "r"],
+        ("mal", "r", ["red-1"]),
         "taken by other teams",
     ),
     "open, pausing: another team's callsigns": (
-        ["--mode", "open", "--on-stall", "pause", "--team", "red:r", "--team", "mal:m"],
-        ("mal", "m", ["red-1"]),
+        ["--mode", "open", "--on-stall", "pause", "--secret", "r"],
+        ("mal", "r", ["red-1"]),
         "taken by other teams",
     ),
     "open, ending: another team's callsigns": (
-        ["--mode", "open", "--on-stall", "end", "--team", "red:r", "--team", "mal:m"],
-        ("mal", "m", ["red-1"]),
+        ["--mode", "open", "--on-stall", "end", "--secret", "r"],
+        ("mal", "r", ["red-1"]),
         "taken by other teams",
     ),
     "open, shared secret: another team's name": (
@@ -198,9 +217,14 @@ SQUATS = {
         ("red", "r", ["mal-1"]),
         "already connected",
     ),
+    "open, own secrets: another client of the team": (
+        ["--mode", "open", "--team", "red:r", "--team", "mal:m"],
+        ("red", "r", ["red-2"]),
+        "already connected",
+    ),
     "fixed, before the start: another team's callsigns": (
-        ["--mode", "fixed", "--teams", "2", "--team", "red:r", "--team", "mal:m"],
-        ("mal", "m", ["red-1"]),
+        ["--mode", "fixed", "--teams", "2", "--secret", "r"],
+        ("mal", "r", ["red-1"]),
         "taken by other teams",
     ),
 }

@@ -216,3 +216,47 @@ def test_wrong_token_and_foreign_aircraft_are_refused(server):
     reply = decode(sock.recv(), "server")
     assert reply["type"] == "error" and reply["code"] == "forbidden"
     sock.close(0)
+
+
+def join_as(sock, team, token, callsigns):
+    sock.send(
+        encode(
+            {
+                "type": "join",
+                "team": team,
+                "token": token,
+                "aircraft": dict.fromkeys(callsigns, "c172p"),
+            }
+        )
+    )
+    return decode(sock.recv(), "server")
+
+
+def test_a_team_cannot_take_the_callsigns_of_a_team_with_its_own_secret(serve, zmq_ctx):
+    """Red team #52.5: blue, with its own secret, joined as red-1 and held it while it
+    reported, and red was refused as a duplicate. A callsign named after a team with its own
+    secret is that team's: blue is refused however it writes red's name in, red flies."""
+    options = ["--mode", "open", "--team", "red:r3d", "--team", "blue:blu3", "--secret", "sh"]
+    address, *_ = serve(*options)
+    sock = zmq_ctx.socket(zmq.DEALER)
+    sock.setsockopt(zmq.RCVTIMEO, 20_000)
+    sock.connect(address)
+    for team, token, callsigns in [
+        ("blue", "blu3", ["red-1"]),  # the finding
+        ("blue", "blu3", ["blue-1", "red1"]),
+        ("blue", "blu3", ["red lead"]),
+        ("blue", "blu3", ["red"]),
+        ("green", "sh", ["red-2"]),  # a team of the shared secret
+    ]:
+        reply = join_as(sock, team, token, callsigns)
+        assert reply["type"] == "error" and reply["code"] == "forbidden", (callsigns, reply)
+        assert f"{callsigns[-1]!r} (of team 'red')" in reply["message"], reply
+    # a team with its own secret flies callsigns named after itself, and is told so
+    reply = join_as(sock, "blue", "blu3", ["ego"])
+    assert reply["code"] == "forbidden" and "'blue-1'" in reply["message"], reply
+    out = {}
+    fly(address, "red", 3, "r3d", out)  # red-1 is red's
+    assert out == {"red": 3}
+    # a name that merely begins alike is no team's: a team of the shared secret flies it
+    assert join_as(sock, "green", "sh", ["reddish", "ego"])["type"] == "welcome"
+    sock.close(0)
