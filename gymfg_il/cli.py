@@ -188,7 +188,53 @@ def run(main: Callable[[], int]) -> int:
 
 
 def progress_bar(total: int, desc: str, unit: str, enabled: bool = True) -> Any:
-    """A tqdm bar on stderr (disabled: nothing is drawn)."""
+    """A tqdm bar on stderr (disabled: nothing is drawn). Where stderr is not a terminal (a
+    log file, CI), a bar would redraw itself into the log: a line every ``LogBar.EVERY_S``
+    seconds and one at the end stand in for it."""
     from tqdm import tqdm
 
+    if enabled and not sys.stderr.isatty():
+        return LogBar(total, desc, unit)
     return tqdm(total=total, desc=desc, unit=unit, disable=not enabled, file=sys.stderr)
+
+
+class LogBar:
+    """A progress bar for a log: plain lines, no redrawing (tqdm's methods that the entry
+    points use)."""
+
+    EVERY_S = 30.0
+
+    def __init__(self, total: int, desc: str, unit: str) -> None:
+        import time
+
+        self.total, self.desc, self.unit, self.n = total, desc, unit, 0
+        self._clock = time.monotonic
+        self._started = self._said = self._clock()
+        self._postfix = ""
+        self._closed = False
+
+    def update(self, n: int = 1) -> None:
+        self.n += n
+        if self._clock() - self._said >= self.EVERY_S:
+            self._say()
+
+    def set_postfix(self, **values: Any) -> None:
+        self._postfix = ", ".join(f"{k}={v}" for k, v in values.items())
+
+    def set_postfix_str(self, text: str, refresh: bool = True) -> None:
+        self._postfix = text
+
+    def close(self) -> None:
+        if not self._closed:
+            self._closed = True
+            self._say()
+
+    def _say(self) -> None:
+        self._said = self._clock()
+        took = self._said - self._started
+        extra = f", {self._postfix}" if self._postfix else ""
+        print(
+            f"{self.desc}: {self.n}/{self.total} {self.unit} in {took:.0f} s{extra}",
+            file=sys.stderr,
+            flush=True,
+        )

@@ -155,7 +155,7 @@ def write_report(run: Path, policy: Path, rows: list[dict[str, object]], seconds
         table(rows),
         "```",
         "",
-        *[f"- {ratio_line(r)}" for r in rows[1:]],
+        *[f"- {ratio_line(r, rows[0])}" for r in rows[1:]],
         "",
         "![loss](loss.png)",
         "",

@@ -67,7 +67,7 @@ def _main(cfg: object, show_progress: bool) -> int:
     )
     print(table(run.rows))
     for row in run.rows[1:]:
-        print(f"\n{ratio_line(row)}")
+        print(f"\n{ratio_line(row, run.rows[0])}")
     pilots = [r for r in run.rows if str(r["agent"]).startswith("pilot:")]
     for pilot in pilots:  # each policy beside the pilot it was scored against, too
         for row in run.rows:

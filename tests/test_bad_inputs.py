@@ -1,6 +1,7 @@
 """Bad input to the command lines gets one clear line and exit status 2, never a traceback
 (red-team findings: each case below raised a traceback before)."""
 
+import os
 import shutil
 import socket
 from pathlib import Path
@@ -271,3 +272,22 @@ def test_a_pilot_name_that_would_break_a_table_is_refused(tmp_path, capsys, name
     assert collect.main(["manual", "--pilot-name", name, "--out", str(tmp_path / "s")]) == 2
     one_error(capsys, "pilot name")
     assert not (tmp_path / "s").exists()
+
+
+def test_a_progress_bar_into_a_log_is_lines_not_redraws(tmp_path):
+    """#53: progress bars redrew themselves ("\\r") into logs when stderr was a file."""
+    import subprocess
+    import sys
+
+    argv = ["autopilot", "--task", "roll", "--episodes", "3", "--episode-time", "4"]
+    with open(tmp_path / "err.log", "w") as err:
+        done = subprocess.run(
+            [sys.executable, "-m", "gymfg_il.collect", *argv, "--out", str(tmp_path / "s")],
+            stdout=subprocess.DEVNULL,
+            stderr=err,
+            env={**os.environ, "HF_HUB_OFFLINE": "1"},
+            timeout=300,
+        )
+    text = (tmp_path / "err.log").read_text()
+    assert done.returncode == 0 and "\r" not in text
+    assert "episodes: 3/3 ep" in text

@@ -1,6 +1,8 @@
 """`train bc`'s command line: the policy's settings are flags of their own, with the names,
 defaults and meanings they always had, built from the registered policy configurations."""
 
+from pathlib import Path
+
 import pytest
 
 from gymfg_il import cli, train
@@ -65,3 +67,17 @@ def test_a_bad_setting_is_one_line_naming_it(tmp_path, capsys):
 )
 def test_durations_read_as_a_wait(seconds, text):
     assert train.duration(seconds) == text
+
+
+def test_train_bc_without_out_never_replaces_an_earlier_policy(tmp_path, monkeypatch):
+    """#53: `train bc` without --out overwrote the last policy of the same task silently."""
+    from gymfg_il import train
+
+    sample = Path(__file__).resolve().parent.parent / "datasets/sample-altitude-c172p/dataset"
+    monkeypatch.chdir(tmp_path)
+    argv = ["bc", "--dataset", str(sample), "--epochs", "1", "--hidden", "16", "--no-progress"]
+    assert train.main(argv) == 0
+    first = (tmp_path / "policies/bc-altitude-c172p-mlp/model.safetensors").read_bytes()
+    assert train.main([*argv, "--seed", "1"]) == 0
+    assert (tmp_path / "policies/bc-altitude-c172p-mlp/model.safetensors").read_bytes() == first
+    assert (tmp_path / "policies/bc-altitude-c172p-mlp-2/model.safetensors").is_file()

@@ -234,6 +234,7 @@ def _build(
             outcome = outcomes[lg.path.name]
             if ref in present:
                 outcome.held.append(ref)
+                outcome.seeds.append(records[ref]["seed"])
                 continue
             columns = logged[ref]
             twin = holder.setdefault(digest(columns["observation.state"], columns["action"]), ref)
@@ -251,6 +252,7 @@ def _build(
                 pictures,
             )
             outcome.added.append(ref)
+            outcome.seeds.append(records[ref]["seed"])
             added += 1
             frames += len(columns["action"])
         builder.finalize(card_root=root)

@@ -40,11 +40,16 @@ class LogOutcome:
     held: list[EpisodeRef] = field(default_factory=list)  # already in the dataset
     left_out: list[str] = field(default_factory=list)  # "what: why"
     damaged: bool = False  # the log's damage is listed with the other logs'
+    seeds: list[int] = field(default_factory=list)  # of the episodes taken
 
     def __str__(self) -> str:
         took = f"{self.name}: took {len(self.added) + len(self.held)} episode(s)"
         if self.added or self.held:
-            took += f" ({episodes_text(self.added + self.held)}; {len(self.added)} new)"
+            seeds = f", seeds {ranges(self.seeds)}" if self.seeds else ""
+            took += (
+                f" (log episodes {episodes_text(self.added + self.held)}{seeds}; "
+                f"{len(self.added)} new)"
+            )
         if self.left_out:
             took += f"; left out: {'; '.join(self.left_out)}"
         if self.damaged:
@@ -59,15 +64,20 @@ def episodes_text(refs: Iterable[EpisodeRef]) -> str:
         by.setdefault(ref.callsign, []).append(ref.episode)
     parts = []
     for callsign, numbers in by.items():
-        runs: list[list[int]] = []
-        for k in sorted(set(numbers)):
-            if runs and k == runs[-1][-1] + 1:
-                runs[-1].append(k)
-            else:
-                runs.append([k])
-        text = ", ".join(f"{r[0]}-{r[-1]}" if len(r) > 1 else str(r[0]) for r in runs)
+        text = ranges(numbers)
         parts.append(text if len(by) == 1 else f"{text} ({callsign})")
     return "; ".join(parts)
+
+
+def ranges(numbers: Iterable[int]) -> str:
+    """Numbers as ranges: "0-3, 7"."""
+    runs: list[list[int]] = []
+    for k in sorted(set(numbers)):
+        if runs and k == runs[-1][-1] + 1:
+            runs[-1].append(k)
+        else:
+            runs.append([k])
+    return ", ".join(f"{r[0]}-{r[-1]}" if len(r) > 1 else str(r[0]) for r in runs)
 
 
 def read_logs(paths: Sequence[Path]) -> tuple[list[Log], list[str], list[Unreadable]]:

@@ -52,8 +52,10 @@ def shares(row: Mapping[str, Any], reference: Mapping[str, Any]) -> dict[str, fl
 
 
 def ratio_line(row: Mapping[str, Any], reference: Mapping[str, Any] | None = None) -> str:
-    """``policy:P / controller: return 99.7%, success 100.0%``: a row's shares of the
-    controller's scores (the row's own ratios), or of another ``reference`` row's."""
+    """``policy:P / controller: return 99.7%, success 100.0% (success rates 94% and 94%)``:
+    a row's scores as shares of the controller's (the row's own ratios), or of another
+    ``reference`` row's; beside the share of success, both success rates (where the
+    reference is given), so that a share above 100% never reads as a rate."""
     against = "controller" if reference is None else str(reference["agent"])
     values = row if reference is None else shares(row, reference)
     parts = []
@@ -61,4 +63,8 @@ def ratio_line(row: Mapping[str, Any], reference: Mapping[str, Any] | None = Non
         value = values[ratio]
         shown = f"n/a (the {against}'s is 0)" if value is None else f"{float(value):.1%}"
         parts.append(f"{what} {shown}")
-    return f"{row['agent']} / {against}: {', '.join(parts)}"
+    rates = ""
+    if reference is not None:
+        mine, theirs = float(row["success_rate"]), float(reference["success_rate"])
+        rates = f" (success rates {mine:.0%} and {theirs:.0%})"
+    return f"{row['agent']} / {against}: {', '.join(parts)}{rates}"

@@ -106,7 +106,7 @@ def _train(
         )
     name = f"bc-{flight.task_label if flight else 'task'}-"
     name += f"{flight.aircraft if flight else 'aircraft'}-{cfg.policy.type}"
-    out = Path(cfg.out) if cfg.out is not None else Path("policies") / name
+    out = Path(cfg.out) if cfg.out is not None else unused(Path("policies") / name)
     check_out(out)  # before training, not after
     train, val = split_by_episode(frames, cfg.val_fraction, cfg.seed)
     image_size = None if frames.images is None else int(frames.images.shape[1])
@@ -143,6 +143,21 @@ def _train(
     stats = (frames.obs_stats, frames.action_stats)
     save_run(out, policy.cpu(), meta, stats, (train_loss, val_loss))
     return TrainResult(out, train_loss, val_loss, seconds, len(train) * steps.epochs, meta)
+
+
+def unused(folder: Path) -> Path:
+    """``folder``, or where it holds something already, the first of ``folder-2``,
+    ``folder-3``, ... that does not exist: a default ``--out`` never replaces an earlier
+    policy (an explicit one does, as asked)."""
+    found, k = folder, 1
+    while found.exists() or found.is_symlink():
+        k += 1
+        found = folder.with_name(f"{folder.name}-{k}")
+    if found != folder:
+        log.warning(
+            "%s holds an earlier policy: this one goes to %s (--out chooses)", folder, found
+        )
+    return found
 
 
 def demonstrations(

@@ -25,7 +25,8 @@ class TrainConfig:
 
     Attributes:
         dataset: LeRobot dataset folder (default: the bundled sample).
-        out: where the checkpoint goes (default: policies/bc-<task>-<aircraft>-<policy>).
+        out: where the checkpoint goes, replacing any policy there (default:
+            policies/bc-<task>-<aircraft>-<policy>, or -2, -3, ... where that holds one).
         policy: the policy trained: a registered policy configuration
             (``policies.factory``) with its settings; on the command line ``--policy`` names
             its type and each setting is a flag of its own.

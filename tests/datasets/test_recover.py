@@ -298,3 +298,12 @@ def test_after_lerobots_delete_episodes_recover_says_what_it_did(copy, capsys):
     assert f"{EPISODES - 1} dataset episode(s) record no log" in said.out
     assert "added back" in said.out and "collect repair" in said.out
     assert "no log" not in said.err
+
+
+def test_what_each_log_gave_names_its_episodes_and_their_seeds(copy, capsys):
+    """#53: "took 4 episode(s) (0-3; ...)" read as eval's seeds 0..15; the numbers are the
+    log's own episodes, and their seeds are said beside them."""
+    assert collect.main(["recover", str(copy)]) == 0
+    assert f"(log episodes 0-{EPISODES - 1}, seeds 3-{3 + EPISODES - 1}; 0 new)" in (
+        capsys.readouterr().out
+    )
