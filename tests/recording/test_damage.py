@@ -221,9 +221,7 @@ def test_chunks_copied_or_moved_with_their_bytes_intact_lose_nothing(session, tm
     assert any(said in note for note in log.damage), log.damage
 
 
-def test_replay_says_when_there_is_nothing_to_replay_or_the_file_is_cut(
-    session, tmp_path, capsys
-):
+def test_replay_says_when_there_is_nothing_to_replay_or_the_file_is_cut(session, tmp_path, capsys):
     """#52.6: `replay` of a folder whose only log is empty exited 0, and a log cut in half
     replayed with no word that it was."""
     empty = tmp_path / "empty"
