@@ -130,9 +130,11 @@ def run(cfg: DemoConfig) -> int:
     )
     result = run_eval(evaluation, _bar(cfg.progress, "episode"))
     write_report(run_dir, policy, result.rows, time.perf_counter() - started)
-    from gymfg_il.evaluation.report import table
+    from gymfg_il.evaluation.report import ratio_line, table
 
     print(table(result.rows))
+    for row in result.rows[1:]:
+        print(f"\n{ratio_line(row, result.rows[0])}")
     print(f"\nreport: {run_dir / 'report.md'}  ({time.perf_counter() - started:.0f} s in all)")
     return 0
 

@@ -28,6 +28,7 @@ def test_main_job_runs_the_whole_loop_and_writes_a_report(tmp_path, capsys):
     out = capsys.readouterr().out
     run = next(tmp_path.iterdir())
     assert f"report: {run / 'report.md'}" in out
+    assert "policy:bc-mlp / controller: return" in out  # #53: the share, not the table alone
     report = (run / "report.md").read_text()
     assert "policy:bc-mlp / controller: return" in report and "![loss](loss.png)" in report
     rows = json.loads((run / "eval.json").read_text())["rows"]
