@@ -51,7 +51,7 @@ def _attributes(doc: str) -> dict[str, str]:
 def summary(cls: type) -> str:
     """The docstring of ``cls`` up to its ``Attributes:`` section, on one line."""
     text = (cls.__doc__ or "").split("Attributes:", 1)[0]
-    return " ".join(text.split())
+    return " ".join(text.replace("``", "`").split())
 
 
 def _default(f: dataclasses.Field[Any]) -> Any:
@@ -63,13 +63,19 @@ def _default(f: dataclasses.Field[Any]) -> Any:
 
 
 def parser(prog: str, doc: str | None, epilog: str | None = None) -> argparse.ArgumentParser:
-    """A parser whose description is ``doc`` as written."""
+    """A parser whose description is ``doc`` as written (its reStructuredText double
+    backquotes as Markdown's single ones: ``x`` reads `x`)."""
     return argparse.ArgumentParser(
         prog=prog,
-        description=doc,
-        epilog=epilog,
+        description=plain(doc),
+        epilog=plain(epilog),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+
+
+def plain(text: str | None) -> str | None:
+    """``text`` with reStructuredText's double backquotes as single ones."""
+    return None if text is None else text.replace("``", "`")
 
 
 def add_fields(

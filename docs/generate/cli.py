@@ -86,6 +86,14 @@ def cell(text: str) -> str:
     return text
 
 
+def prose(text: str) -> str:
+    """A description or epilog as Markdown paragraphs (not a code block, whose long lines
+    would be cut off): its indented lines (commands, examples) stay a code block."""
+    lines = text.replace("``", "`").splitlines()
+    margin = min((len(x) - len(x.lstrip()) for x in lines if x.strip()), default=0)
+    return "\n".join(html.escape(x[margin:], quote=False) for x in lines) + "\n\n"
+
+
 def flag(action: argparse.Action) -> str:
     names = ", ".join(action.option_strings) or action.metavar or action.dest
     if action.choices and not isinstance(action, argparse._SubParsersAction):
@@ -101,7 +109,7 @@ def describe(p: argparse.ArgumentParser, level: int, about: str = "") -> Iterato
     yield f"{'#' * level} `{p.prog}`\n\n"
     description = (p.description or about).strip("\n")
     if description:
-        yield "```text\n" + description + "\n```\n\n"
+        yield prose(description)
     yield "```text\n" + p.format_usage().strip() + "\n```\n\n"
     formatter = p._get_formatter()
     rows, subs = [], []
@@ -119,7 +127,7 @@ def describe(p: argparse.ArgumentParser, level: int, about: str = "") -> Iterato
         yield from rows
         yield "\n"
     if p.epilog:
-        yield "```text\n" + p.epilog.strip("\n") + "\n```\n\n"
+        yield prose(p.epilog.strip("\n"))
     if subs:
         yield "| command | what it does |\n| --- | --- |\n"
         yield from (f"| `{name}` | {cell(h)} |\n" for name, _, h in subs)
