@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import shutil
 import stat
 import sys
@@ -29,10 +30,14 @@ from pathlib import Path
 from gymfg_il.errors import ConfigError
 
 # what a policy folder holds: ``train bc``'s files, ``train ppo``'s curve, and folders of
-# what ``train ppo`` writes (its TensorBoard log); each is checked by kind and content
+# what ``train ppo`` writes (its TensorBoard log, and with --checkpoints each evaluated actor
+# as a policy, ``checkpoints/step-N`` and ``checkpoints/average``: ``rl.judge``); each is
+# checked by kind and content (``foreign_files``)
 POLICY_FILES = frozenset(
     {"config.json", "model.safetensors", "loss.png", "train_log.json", "curve.json", "curve.png"}
 )
+CHECKPOINT = re.compile(r"step-\d+|average")  # the names of the actors in checkpoints/
+CHECKPOINT_FILES = frozenset({"config.json", "model.safetensors"})  # what ``save_policy`` writes
 EVENTS = "events.out.tfevents."  # how torch's SummaryWriter names TensorBoard event files
 PARTIAL, OLD = "partial", "old"
 AT_FDCWD, RENAME_EXCHANGE = -100, 2  # <fcntl.h>, <linux/fs.h>
@@ -67,15 +72,36 @@ def foreign_files(folder: Path) -> list[str]:
     """What in the policy folder ``folder`` a save did not write, one entry each (its path
     in the folder, and why where the name is a policy's): a policy's file names must be
     regular files (no folder, link or FIFO), ``tensorboard/`` must hold TensorBoard event
-    files only."""
+    files only, ``checkpoints/`` only the policies ``train ppo --checkpoints`` saved."""
     found = []
     for path in sorted(folder.iterdir()):
         if path.name in POLICY_FILES:
             found += [] if _regular(path) else [f"{path.name}: {_kind(path)}, not a file"]
         elif path.name == "tensorboard":
             found += _foreign_events(path, "tensorboard")
+        elif path.name == "checkpoints":
+            found += _foreign_checkpoints(path)
         else:
             found.append(path.name)
+    return found
+
+
+def _foreign_checkpoints(path: Path) -> list[str]:
+    """What in ``checkpoints/`` is not an evaluated actor ``train ppo --checkpoints`` saved:
+    a folder ``step-N`` or ``average`` holding a policy's config.json and weights alone."""
+    if not _folder(path):
+        return [f"checkpoints: {_kind(path)}, not the folder train ppo --checkpoints writes"]
+    found = []
+    for actor in sorted(path.iterdir()):
+        where = f"checkpoints/{actor.name}"
+        if not (_folder(actor) and CHECKPOINT.fullmatch(actor.name)):
+            found.append(f"{where}: not a step-N or average policy folder")
+            continue
+        for part in sorted(actor.iterdir()):
+            if part.name not in CHECKPOINT_FILES:
+                found.append(f"{where}/{part.name}: not a policy's file")
+            elif not _regular(part):
+                found.append(f"{where}/{part.name}: {_kind(part)}, not a file")
     return found
 
 

@@ -6,6 +6,7 @@ only, checked by kind and content, not by name alone (red team, issue 52). A fol
 from __future__ import annotations
 
 import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -94,3 +95,39 @@ def test_train_bc_never_replaces_a_users_tensorboard_folder(tmp_path, capsys):
     assert train.main(argv) == 2
     one_error(capsys, "tensorboard/experiment-notes.md", "give a new or empty folder")
     assert mine.read_text() == "the user's"
+
+
+def test_a_ppo_checkpoints_folder_is_replaced_by_a_later_save(tmp_path, capsys):
+    """A ``train ppo --checkpoints`` folder takes a later ``train bc`` (or ``train ppo``):
+    the save replaces it whole, checkpoints and all."""
+    out = tmp_path / "p"
+    ppo_policy_files(out, checkpoints=True)
+    check_out(out)  # no error
+    argv = ["bc", "--dataset", str(SAMPLE), "--epochs", "1", "--out", str(out), "--no-progress"]
+    assert train.main(argv) == 0, capsys.readouterr().err
+    held = sorted(p.name for p in out.iterdir())
+    assert held == ["config.json", "loss.png", "model.safetensors", "train_log.json"]
+
+
+@pytest.mark.parametrize(
+    "damage, named",
+    [
+        (lambda p: _user_file(p / "checkpoints", "notes.txt"), "checkpoints/notes.txt"),
+        (lambda p: _user_file(p / "checkpoints" / "step-0", "notes.txt"),
+         "checkpoints/step-0/notes.txt"),
+        (lambda p: _user_file(p / "checkpoints" / "mine", "config.json"), "checkpoints/mine"),
+        (lambda p: _user_file(p / "checkpoints" / "step-0" / "config.json", "x"),
+         "checkpoints/step-0/config.json"),
+        (lambda p: shutil.rmtree(p / "checkpoints") or _user_file(p, "checkpoints"),
+         "checkpoints"),
+    ],
+)  # fmt: skip
+def test_a_checkpoints_folder_holding_a_users_files_is_refused(tmp_path, damage, named):
+    out = tmp_path / "p"
+    ppo_policy_files(out, checkpoints=True)
+    if (out / "checkpoints" / "step-0" / "config.json").exists():
+        (out / "checkpoints" / "step-0" / "config.json").unlink()
+    damage(out)
+    with pytest.raises(ConfigError) as err:
+        check_out(out)
+    assert f"({named}: " in str(err.value)
