@@ -10,9 +10,11 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.files import JSON_LIMIT, WEIGHTS_LIMIT, check_regular, read_regular
 from gymfg_il.policies.factory import make_policy, policy_type
 
 CONFIG_FILE, WEIGHTS_FILE = "config.json", "model.safetensors"
+REPLACE = "put the file `train bc` wrote in its place, or train the policy again"
 
 
 def _stats_json(stats: dict[str, np.ndarray]) -> dict[str, list[float]]:
@@ -46,15 +48,20 @@ def save_policy(
 
 
 def read_config(path: Path) -> dict[str, Any]:
+    """What the policy checkpoint at ``path`` says of itself (its ``config.json``), after
+    checking that it and its weights are regular files (``gymfg_il.files``)."""
     path = Path(path)
-    if not (path / CONFIG_FILE).is_file() or not (path / WEIGHTS_FILE).is_file():
+    try:
+        check_regular(path / WEIGHTS_FILE, WEIGHTS_LIMIT, REPLACE)
+        text = read_regular(path / CONFIG_FILE, JSON_LIMIT, REPLACE)
+    except FileNotFoundError:
         raise ConfigError(
             f"{path} is not a policy checkpoint (needs {CONFIG_FILE} and {WEIGHTS_FILE}): give "
             "a folder `python -m gymfg_il.train bc` wrote, or a LeRobot checkpoint "
             "(lerobot-train's output folder or its .../pretrained_model)"
-        )
+        ) from None
     try:
-        data = json.loads((path / CONFIG_FILE).read_text())
+        data = json.loads(text)
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
         raise ConfigError(f"{path / CONFIG_FILE} is not valid JSON ({err}); train again") from None
     need = ("type", "policy", "obs_stats", "action_stats")

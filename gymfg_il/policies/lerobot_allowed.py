@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.files import JSON_LIMIT, WEIGHTS_LIMIT, read_regular
 
 POLICY_TYPES = frozenset(
     {"act", "diffusion", "tdmpc", "vqbet", "multi_task_dit", "pi0", "pi05", "smolvla"}
@@ -53,6 +54,7 @@ PROCESSOR_STEPS = frozenset(
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
 BACKBONES = frozenset({"resnet18", "resnet34", "resnet50", "resnet101", "resnet152"})
 FIX = "use a checkpoint lerobot-train wrote for one of LeRobot's own policies, or train it again"
+REPLACE = "put the file lerobot-train wrote in its place, or train the checkpoint again"
 
 
 class UnsafeCheckpointError(ConfigError):
@@ -86,12 +88,13 @@ def checked_files(folder: Path) -> dict[str, bytes]:
 
 
 def _bytes(path: Path) -> bytes | None:
+    """The file's bytes, None where it is missing; a regular file only, else
+    ``NotRegularFileError`` (a FIFO hung the load, /dev/zero filled memory)."""
+    limit = JSON_LIMIT if path.suffix == ".json" else WEIGHTS_LIMIT
     try:
-        return path.read_bytes()
+        return read_regular(path, limit, REPLACE)
     except FileNotFoundError:
         return None
-    except OSError as err:
-        raise UnsafeCheckpointError(f"{path} cannot be read ({err.strerror}); {FIX}") from None
 
 
 def _parsed(folder: Path, name: str, files: dict[str, bytes]) -> Any:

@@ -6,6 +6,7 @@ one, and a damaged dataset is one line "error: ..." with exit status 2."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -106,6 +107,45 @@ def test_eval_refuses_the_hostile_step_in_one_line(act_checkpoint, tmp_path, cap
     assert evaluate.main(argv) == 2
     one_error(capsys, "'os.system'")
     assert not marker.exists()
+
+
+def state_file(folder):
+    return next(p.name for p in folder.glob("*.safetensors") if p.name != "model.safetensors")
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    "make",
+    [
+        pytest.param(os.mkfifo, id="fifo"),
+        pytest.param(lambda p: p.symlink_to("/dev/zero"), id="dev-zero"),
+        pytest.param(lambda p: p.symlink_to("/dev/urandom"), id="dev-urandom"),
+    ],
+)
+@pytest.mark.parametrize(
+    "name",
+    [
+        "config.json",
+        "train_config.json",
+        "policy_preprocessor.json",
+        "policy_postprocessor.json",
+        "model.safetensors",
+        state_file,
+    ],
+)
+def test_eval_refuses_a_checkpoint_file_that_is_not_a_file(
+    act_checkpoint, tmp_path, capsys, name, make
+):
+    """#52.7: a FIFO in the place of a checkpoint's file hung eval (its open waits for a
+    writer); a link to /dev/zero or /dev/urandom read until memory ran out."""
+    folder = tmp_path / "pretrained_model"
+    shutil.copytree(act_checkpoint, folder)
+    name = name if isinstance(name, str) else name(folder)
+    (folder / name).unlink(missing_ok=True)  # lerobot-train writes train_config.json
+    make(folder / name)
+    argv = ["--policy", str(folder), "--task", "altitude", "--aircraft", "c172p"]
+    assert evaluate.main([*argv, "--episodes", "1", "--no-progress"]) == 2
+    one_error(capsys, f"{folder / name} is ")
 
 
 @pytest.mark.parametrize(
