@@ -179,6 +179,35 @@ def test_eval_refuses_a_checkpoint_file_that_is_not_a_file(
             lambda d: d.update(vision_backbone="get_model"),
             "vision_backbone 'get_model'",
         ),
+        (  # #52.12: with transformers installed, LeRobot would fetch the tokenizer named
+            "policy_preprocessor.json",
+            lambda d: d["steps"].append(
+                {"registry_name": "tokenizer_processor", "config": {"tokenizer_name": "/tmp/x"}}
+            ),
+            "tokenizer_name '/tmp/x'",
+        ),
+        (
+            "policy_preprocessor.json",
+            lambda d: d["steps"].append(
+                {"registry_name": "tokenizer_processor", "config": {"tokenizer_name": "me/tok"}}
+            ),
+            "tokenizer_name 'me/tok'",
+        ),
+        (
+            "policy_preprocessor.json",
+            lambda d: d["steps"].append({"registry_name": "tokenizer_processor", "config": []}),
+            "tokenizer_name None",
+        ),
+        (  # SmolVLA's and multi-task DiT's models fetch these
+            "config.json",
+            lambda d: d.update(vlm_model_name="me/vlm"),
+            "vlm_model_name 'me/vlm'",
+        ),
+        (
+            "config.json",
+            lambda d: d.update(text_encoder_name="me/clip"),
+            "text_encoder_name 'me/clip'",
+        ),
     ],
 )
 def test_names_outside_lerobots_own_policies_are_refused(
@@ -188,6 +217,19 @@ def test_names_outside_lerobots_own_policies_are_refused(
     with pytest.raises(UnsafeCheckpointError) as err:
         LeRobotAgent(folder)
     assert needle in str(err.value)
+
+
+def test_the_tokenizers_lerobots_own_policies_name_are_let_through(act_checkpoint, tmp_path):
+    from gymfg_il.policies.lerobot_allowed import checked_files
+
+    step = {
+        "registry_name": "tokenizer_processor",
+        "config": {"tokenizer_name": "google/paligemma-3b-pt-224", "max_length": 48},
+    }
+    folder = hostile(
+        act_checkpoint, tmp_path, "policy_preprocessor.json", lambda d: d["steps"].append(step)
+    )
+    assert "policy_preprocessor.json" in checked_files(folder)
 
 
 # --- train bc on damaged or non-finite datasets -------------------------------------------
