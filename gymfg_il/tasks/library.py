@@ -297,7 +297,15 @@ def _import_task(path: str) -> type[Task]:
             f"cannot import task {path!r} ({err}); is its package installed?"
         ) from None
     if not (isinstance(found, type) and issubclass(found, Task)):
-        raise ConfigError(f"{path!r} is {found!r}, not a Task class")
+        what = (
+            f"the class {found.__name__}"
+            if isinstance(found, type)
+            else f"a {type(found).__name__}"
+        )
+        raise ConfigError(  # its type, not its value: sys:modules printed every module
+            f"{path!r} is {what}, not a Task class; name a Task subclass as "
+            "'package.module:ClassName'"
+        )
     return found
 
 
