@@ -66,12 +66,30 @@ def read_config(path: Path) -> dict[str, Any]:
         raise ConfigError(f"{path / CONFIG_FILE} is not valid JSON ({err}); train again") from None
     need = ("type", "policy", "obs_stats", "action_stats")
     missing = [k for k in need if not isinstance(data, dict) or k not in data]
+    if missing and isinstance(data, dict) and "input_features" in data:
+        raise ConfigError(_lerobot_here(path, data.get("type")))
     if missing:
         raise ConfigError(
             f"{path / CONFIG_FILE} is neither our policy config (no {missing}) nor a LeRobot "
             "policy's (no input_features): give a folder `train bc` or lerobot-train wrote"
         )
     return data
+
+
+def _lerobot_here(path: Path, kind: Any) -> str:
+    """Why a LeRobot checkpoint cannot be what needs one of GymFG's own policies (the start
+    of ``train ppo --init``; ``eval`` flies LeRobot checkpoints through their own loader)."""
+    from gymfg_il.policies.configuration_mlp import MLPConfig
+    from gymfg_il.policies.factory import policy_types
+
+    types = policy_types()
+    mlps = [n for n, t in types.items() if issubclass(t.config, MLPConfig)]
+    return (
+        f"{path} is a LeRobot checkpoint ({kind!r}), not one of GymFG's own policies "
+        f"({', '.join(types)}): PPO fine-tunes GymFG's own MLP policies ({', '.join(mlps)}; "
+        "`train bc --policy mlp` writes one) and cannot start from a LeRobot checkpoint; "
+        "eval flies it as it is"
+    )
 
 
 def load_policy(path: Path, device: str = "cpu") -> tuple[Any, dict[str, Any]]:

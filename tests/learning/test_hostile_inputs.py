@@ -232,6 +232,15 @@ def test_the_tokenizers_lerobots_own_policies_name_are_let_through(act_checkpoin
     assert "policy_preprocessor.json" in checked_files(folder)
 
 
+def test_ppo_says_a_lerobot_checkpoint_cannot_be_its_start(act_checkpoint, tmp_path, capsys):
+    """#52.12: ``train ppo --init`` of an ACT checkpoint said its config had "no
+    input_features"; it has them, and PPO fine-tunes GymFG's own MLP policies only."""
+    argv = ["ppo", "--init", str(act_checkpoint), "--out", str(tmp_path / "p"), "--no-progress"]
+    assert train.main(argv) == 2
+    one_error(capsys, "is a LeRobot checkpoint ('act')", "mlp, ppo", "cannot start from")
+    assert not (tmp_path / "p").exists()
+
+
 # --- train bc on damaged or non-finite datasets -------------------------------------------
 
 
