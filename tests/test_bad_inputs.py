@@ -129,6 +129,27 @@ def test_eval_checks_a_policy_before_anything_flies(policy, tmp_path, capsys, da
     one_error(capsys, needle)
 
 
+@pytest.mark.parametrize("task", ["sys:modules", "os:environ"])
+def test_a_record_naming_a_module_attribute_as_its_task_is_one_short_line(
+    policy, tmp_path, capsys, task
+):
+    """#52.12: a policy whose flight spec names ``sys:modules`` as its task printed all of
+    ``sys.modules`` (``os:environ``: the environment, secrets and all) in its error."""
+    import json
+
+    named = tmp_path / "named"
+    shutil.copytree(policy, named)
+    config = json.loads((named / "config.json").read_text())
+    config["spec"]["teams"][0]["roster"][0]["task"] = task
+    (named / "config.json").write_text(json.dumps(config))
+    assert evaluate.main(["--policy", str(named), "--episodes", "1", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "Traceback" not in err, err[:500]
+    kind = "dict" if task == "sys:modules" else "_Environ"
+    assert f"{task!r} is a {kind}, not a Task class" in err, err[:500]
+    assert len(err) < 300, err[:500]
+
+
 def test_serve_and_replay_refuse_impossible_ports_and_addresses(capsys):
     for argv in (
         ["--port", "99999"],

@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[1] / "gymfg_il"
 
 # bottom to top; a package may import from its own layer and the ones before it
 LAYERS = [
-    {"errors", "typecheck", "names", "units", "moved", "agent"},
+    {"errors", "typecheck", "names", "units", "moved", "agent", "files"},
     {"aircraft", "workers"},
     {"sim"},
     {"flightgear"},

@@ -12,6 +12,7 @@ from gymfg_il.collectors.session import DATASET, LOGS
 from gymfg_il.datasets.episode_logs import EpisodeRef, base_refs, dataset_refs, unrebuildable
 from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
 from gymfg_il.datasets.gather import read_logs, set_aside
+from gymfg_il.datasets.health import check_files
 from gymfg_il.errors import ConfigError
 from gymfg_il.names import check_name
 from gymfg_il.recording.reader import EmptyLog, Log, read_log
@@ -224,6 +225,7 @@ def recover(folder: Path, callsigns: Sequence[str] | None = None) -> int:
             "collection session folder?)"
         )
     root = folder / DATASET
+    check_files(root)  # a FIFO in a file's place would hang every reader below
     # what the dataset should hold: its episodes as its table lists them (also when LeRobot
     # cannot load it) and a DAgger session's base episodes
     before = dataset_refs(root)

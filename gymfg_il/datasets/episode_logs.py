@@ -29,8 +29,13 @@ from pathlib import Path
 from typing import Any
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.files import JSON_LIMIT, PARQUET_LIMIT, read_regular, regular_problem
 
 BASE_EPISODES = "base-episodes.json"
+BASE_FIX = (
+    "it names the base episodes of a DAgger session: restore it, or delete it to rebuild "
+    "every episode of the linked logs"
+)
 log = logging.getLogger(__name__)
 _NAME_MAX = 255  # a file name's length on common file systems
 
@@ -74,6 +79,9 @@ def dataset_refs(root: Path) -> list[tuple[int, EpisodeRef | None]]:
     wanted = ["episode_index", "gymfg/log", "gymfg/log_episode", "gymfg/callsign"]
     rows: list[tuple[int, EpisodeRef | None]] = []
     for path in sorted((Path(root) / "meta" / "episodes").rglob("*.parquet")):
+        if problem := regular_problem(path, PARQUET_LIMIT):  # a FIFO's open would hang
+            log.warning("could not read %s: it %s; its episodes are not checked", path, problem)
+            continue
         try:
             names = pq.read_schema(path).names
             table = pq.read_table(path, columns=[c for c in wanted if c in names])
@@ -157,10 +165,12 @@ def base_refs(folders: Iterable[Path]) -> list[tuple[int, EpisodeRef | None]]:
     out: list[tuple[int, EpisodeRef | None]] = []
     for folder in folders:
         path = Path(folder) / BASE_EPISODES
-        if not path.is_file():
+        try:
+            raw = read_regular(path, JSON_LIMIT, BASE_FIX)
+        except FileNotFoundError:
             continue
         try:
-            record = json.loads(path.read_text())
+            record = json.loads(raw)
             for e in record["episodes"]:
                 ref = None
                 if e.get("log") is not None:
@@ -168,10 +178,7 @@ def base_refs(folders: Iterable[Path]) -> list[tuple[int, EpisodeRef | None]]:
                     ref = EpisodeRef(e["log"], int(e["log_episode"]), e["callsign"])
                 out.append((int(e["index"]), ref))
         except (ValueError, KeyError, TypeError) as err:
-            raise ConfigError(
-                f"{path} is malformed ({err}); it names the base episodes of a DAgger session: "
-                "restore it, or delete it to rebuild every episode of the linked logs"
-            ) from None
+            raise ConfigError(f"{path} is malformed ({err}); {BASE_FIX}") from None
     return out
 
 

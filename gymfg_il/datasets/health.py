@@ -2,8 +2,9 @@
 
 LeRobot itself, given a dataset with a file missing, tries to download the rest from the Hub
 (and, offline, fails with a network error that says nothing about the dataset). This looks
-first: the metadata files parse, the statistics and task table are there, and the data files
-are readable parquet holding every frame the metadata counts.
+first: the files are regular files (``file_problems``), the metadata files parse, the
+statistics and task table are there, and the data files are readable parquet holding every
+frame the metadata counts.
 """
 
 from __future__ import annotations
@@ -11,13 +12,50 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.files import JSON_LIMIT, PARQUET_LIMIT, VIDEO_LIMIT, regular_problem
+
+# the files of a dataset that are read, by suffix, and the most read of each
+READ = {".json": JSON_LIMIT, ".parquet": PARQUET_LIMIT, ".mp4": VIDEO_LIMIT}
+REPLACE = (
+    "put the file itself there (a link to a regular file is fine), or move the dataset "
+    "aside and rebuild it from its logs with `python -m gymfg_il.collect recover SESSION`"
+)
+
+
+def file_problems(root: Path) -> list[str]:
+    """Each file of the dataset at ``root`` that is read (``meta/``, ``data/`` and
+    ``videos/``: JSON, parquet, video) but is not a regular file, or is larger than one
+    can be: a FIFO in a file's place hangs its reader, a link to /dev/zero fills memory.
+    One line each, the file's path in the dataset first."""
+    problems = []
+    for part in ("meta", "data", "videos"):
+        for path in sorted((root / part).rglob("*")):
+            limit = READ.get(path.suffix)
+            problem = None if limit is None else regular_problem(path, limit)
+            if problem:
+                problems.append(f"{path.relative_to(root)} {problem}")
+    return problems
+
+
+def check_files(root: Path) -> None:
+    """ConfigError naming every file ``file_problems`` finds in the dataset at ``root``;
+    called before anything reads the dataset."""
+    problems = file_problems(root)
+    if len(problems) == 1:
+        raise ConfigError(f"the dataset at {root}: {problems[0]}; {REPLACE}")
+    if problems:
+        raise ConfigError(join_problems(f"the dataset at {root}", problems) + f"\n{REPLACE}")
+
 
 def dataset_problems(root: Path) -> list[str]:
     """What keeps the dataset at ``root`` from being read whole (empty: nothing)."""
     import pyarrow.parquet as pq
 
     meta = root / "meta"
-    problems = []
+    problems = file_problems(root)
+    if problems:
+        return problems
     for name in ("info.json", "stats.json"):
         path = meta / name
         if not path.is_file():

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gymfg_il.datasets.health import file_problems
 from gymfg_il.errors import ConfigError, GymFGError, join_problems
 
 if TYPE_CHECKING:
@@ -31,13 +32,14 @@ class NonFiniteDataError(ConfigError):
 
 
 def meta_problems(root: Path) -> list[str]:
-    """What in ``root/meta`` LeRobot would fail on: ``info.json``'s ``fps`` and features,
-    and the episode and task tables as parquet."""
+    """What in ``root/meta`` LeRobot would fail on: a file that is not a regular file (in
+    all of the dataset: ``datasets.health.file_problems``), ``info.json``'s ``fps`` and
+    features, and the episode and task tables as parquet."""
     import pyarrow.parquet as pq
 
     meta = root / "meta"
-    problems: list[str] = []
-    if not (meta / "info.json").is_file():
+    problems: list[str] = file_problems(root)  # before anything opens a FIFO or a device
+    if problems or not (meta / "info.json").is_file():
         return problems  # datasets.health says what is missing
     try:
         info = json.loads((meta / "info.json").read_text())

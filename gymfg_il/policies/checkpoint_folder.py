@@ -9,13 +9,19 @@ disk, and puts the staged folder in the policy's place in one step: a rename whe
 no policy yet, else Linux's ``renameat2(RENAME_EXCHANGE)``, which swaps the two folders
 atomically. Where the system has no exchange, the old folder is first renamed aside
 (``.NAME.old-PID``) and put back by the next save should a kill fall between the two renames.
+
+Replacing the folder deletes what it held, so ``check_out`` lets a save replace only what a
+save wrote, by kind and content as well as name: a folder named ``loss.png`` or a
+``tensorboard/`` holding a user's notes is the user's, and refused.
 """
 
 from __future__ import annotations
 
 import errno
 import os
+import re
 import shutil
+import stat
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -23,26 +29,32 @@ from pathlib import Path
 
 from gymfg_il.errors import ConfigError
 
-# what a policy folder holds (``train bc``'s, and ``train ppo``'s curve and TensorBoard log)
+# what a policy folder holds: ``train bc``'s files, ``train ppo``'s curve, and folders of
+# what ``train ppo`` writes (its TensorBoard log, and with --checkpoints each evaluated actor
+# as a policy, ``checkpoints/step-N`` and ``checkpoints/average``: ``rl.judge``); each is
+# checked by kind and content (``foreign_files``)
 POLICY_FILES = frozenset(
-    {"config.json", "model.safetensors", "loss.png", "train_log.json"}
-    | {"curve.json", "curve.png", "tensorboard"}
+    {"config.json", "model.safetensors", "loss.png", "train_log.json", "curve.json", "curve.png"}
 )
+CHECKPOINT = re.compile(r"step-\d+|average")  # the names of the actors in checkpoints/
+CHECKPOINT_FILES = frozenset({"config.json", "model.safetensors"})  # what ``save_policy`` writes
+EVENTS = "events.out.tfevents."  # how torch's SummaryWriter names TensorBoard event files
 PARTIAL, OLD = "partial", "old"
 AT_FDCWD, RENAME_EXCHANGE = -100, 2  # <fcntl.h>, <linux/fs.h>
+SHOWN = 5  # foreign files named in the error
 
 
 def check_out(out: Path) -> None:
     """Refuse, before anything is trained, an ``out`` that is a file, whose folder cannot be
-    written, or that holds files other than a policy's (replacing the folder would delete
-    them)."""
+    written, or that holds anything a policy's save did not write (``foreign_files``:
+    replacing the folder would delete it)."""
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out {out} is a file; give a folder for the policy")
     if out.is_dir():
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in POLICY_FILES)
+        foreign = foreign_files(out)
         if foreign:
-            shown = ", ".join(foreign[:5]) + (", ..." if len(foreign) > 5 else "")
+            shown = "; ".join(foreign[:SHOWN]) + ("; ..." if len(foreign) > SHOWN else "")
             raise ConfigError(
                 f"--out {out} holds files that are not a policy's ({shown}); saving replaces "
                 "the whole folder: give a new or empty folder, or a policy's folder"
@@ -54,6 +66,72 @@ def check_out(out: Path) -> None:
         probe.rmdir()
     except OSError as err:
         raise ConfigError(f"--out {out}: cannot write there ({err.strerror})") from None
+
+
+def foreign_files(folder: Path) -> list[str]:
+    """What in the policy folder ``folder`` a save did not write, one entry each (its path
+    in the folder, and why where the name is a policy's): a policy's file names must be
+    regular files (no folder, link or FIFO), ``tensorboard/`` must hold TensorBoard event
+    files only, ``checkpoints/`` only the policies ``train ppo --checkpoints`` saved."""
+    found = []
+    for path in sorted(folder.iterdir()):
+        if path.name in POLICY_FILES:
+            found += [] if _regular(path) else [f"{path.name}: {_kind(path)}, not a file"]
+        elif path.name == "tensorboard":
+            found += _foreign_events(path, "tensorboard")
+        elif path.name == "checkpoints":
+            found += _foreign_checkpoints(path)
+        else:
+            found.append(path.name)
+    return found
+
+
+def _foreign_checkpoints(path: Path) -> list[str]:
+    """What in ``checkpoints/`` is not an evaluated actor ``train ppo --checkpoints`` saved:
+    a folder ``step-N`` or ``average`` holding a policy's config.json and weights alone."""
+    if not _folder(path):
+        return [f"checkpoints: {_kind(path)}, not the folder train ppo --checkpoints writes"]
+    found = []
+    for actor in sorted(path.iterdir()):
+        where = f"checkpoints/{actor.name}"
+        if not (_folder(actor) and CHECKPOINT.fullmatch(actor.name)):
+            found.append(f"{where}: not a step-N or average policy folder")
+            continue
+        for part in sorted(actor.iterdir()):
+            if part.name not in CHECKPOINT_FILES:
+                found.append(f"{where}/{part.name}: not a policy's file")
+            elif not _regular(part):
+                found.append(f"{where}/{part.name}: {_kind(part)}, not a file")
+    return found
+
+
+def _foreign_events(path: Path, where: str) -> list[str]:
+    """What in the TensorBoard log folder ``path`` (``where`` in the policy folder) is not
+    a folder of event files (stable-baselines3 writes ``ppo_N/events.out.tfevents.*``)."""
+    if not _folder(path):
+        return [f"{where}: {_kind(path)}, not a TensorBoard log folder"]
+    found = []
+    for part in sorted(path.iterdir()):
+        inside = f"{where}/{part.name}"
+        if _folder(part):
+            found += _foreign_events(part, inside)
+        elif not (_regular(part) and part.name.startswith(EVENTS)):
+            found.append(f"{inside}: not a TensorBoard event file")
+    return found
+
+
+def _regular(path: Path) -> bool:
+    return stat.S_ISREG(path.lstat().st_mode)
+
+
+def _folder(path: Path) -> bool:
+    return stat.S_ISDIR(path.lstat().st_mode)
+
+
+def _kind(path: Path) -> str:
+    mode = path.lstat().st_mode
+    kinds = {stat.S_ISDIR: "a folder", stat.S_ISLNK: "a link", stat.S_ISFIFO: "a FIFO"}
+    return next((what for test, what in kinds.items() if test(mode)), "a special file")
 
 
 @contextmanager

@@ -13,7 +13,11 @@ names LeRobot's own policies write (LeRobot 0.6), collected here:
 - their processor steps, all of which LeRobot saves by ``registry_name`` (a ``class`` entry
   is never LeRobot's own and is refused);
 - state files by plain name inside the checkpoint folder, and a torchvision ResNet as the
-  vision backbone (the modeling code calls ``torchvision.models.<vision_backbone>``).
+  vision backbone (the modeling code calls ``torchvision.models.<vision_backbone>``);
+- the models and tokenizers LeRobot fetches by name (from the Hub, or a local folder) only
+  as its own policies name them: a ``tokenizer_processor`` step's ``tokenizer_name`` and
+  ``config.json``'s ``vlm_model_name`` (SmolVLA), ``vision_encoder_name`` and
+  ``text_encoder_name`` (multi-task DiT), pinned to the names those policies write.
 
 Left out on purpose: steps that load code or tokenizers with ``trust_remote_code``
 (``action_tokenizer_processor``; pi0-FAST, GR00T, Wall-X) and robot/teleoperation steps no
@@ -29,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.files import JSON_LIMIT, WEIGHTS_LIMIT, read_regular
 
 POLICY_TYPES = frozenset(
     {"act", "diffusion", "tdmpc", "vqbet", "multi_task_dit", "pi0", "pi05", "smolvla"}
@@ -52,7 +57,17 @@ PROCESSOR_STEPS = frozenset(
 )
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
 BACKBONES = frozenset({"resnet18", "resnet34", "resnet50", "resnet101", "resnet152"})
+# what LeRobot fetches by name: the tokenizers its policies' processors name (pi0 and pi0.5:
+# PaliGemma's; SmolVLA: its VLM's; multi-task DiT: its CLIP text encoder's) and, in
+# config.json, the models SmolVLA and multi-task DiT load (their configurations' defaults)
+PINNED_MODELS = {
+    "vlm_model_name": "HuggingFaceTB/SmolVLM2-500M-Video-Instruct",
+    "vision_encoder_name": "openai/clip-vit-base-patch16",
+    "text_encoder_name": "openai/clip-vit-base-patch16",
+}
+TOKENIZERS = frozenset({"google/paligemma-3b-pt-224", *PINNED_MODELS.values()})
 FIX = "use a checkpoint lerobot-train wrote for one of LeRobot's own policies, or train it again"
+REPLACE = "put the file lerobot-train wrote in its place, or train the checkpoint again"
 
 
 class UnsafeCheckpointError(ConfigError):
@@ -86,12 +101,13 @@ def checked_files(folder: Path) -> dict[str, bytes]:
 
 
 def _bytes(path: Path) -> bytes | None:
+    """The file's bytes, None where it is missing; a regular file only, else
+    ``NotRegularFileError`` (a FIFO hung the load, /dev/zero filled memory)."""
+    limit = JSON_LIMIT if path.suffix == ".json" else WEIGHTS_LIMIT
     try:
-        return path.read_bytes()
+        return read_regular(path, limit, REPLACE)
     except FileNotFoundError:
         return None
-    except OSError as err:
-        raise UnsafeCheckpointError(f"{path} cannot be read ({err.strerror}); {FIX}") from None
 
 
 def _parsed(folder: Path, name: str, files: dict[str, bytes]) -> Any:
@@ -116,6 +132,12 @@ def _config_problems(config: Any) -> list[str]:
             f"config.json: vision_backbone {backbone!r} is not a ResNet torchvision ships "
             f"({', '.join(sorted(BACKBONES))})"
         )
+    for key, pinned in PINNED_MODELS.items():
+        if key in config and config[key] != pinned:
+            problems.append(
+                f"config.json: {key} {config[key]!r} is not the model LeRobot's own policy "
+                f"names ({pinned!r}); LeRobot would fetch and load it"
+            )
     return problems
 
 
@@ -146,12 +168,26 @@ def _pipeline_problems(name: str, pipeline: Any, states: list[str]) -> list[str]
             )
         elif "class" not in step and "registry_name" not in step:
             problems.append(f"{where} names no registry_name")
+        elif registry == "tokenizer_processor":
+            problems += _tokenizer_problems(where, step.get("config"))
         state = step.get("state_file")
         if state is not None and not _plain_file(state):
             problems.append(f"{where} state_file {state!r} is not a file name in the folder")
         elif state is not None:
             states.append(state)
     return problems
+
+
+def _tokenizer_problems(where: str, config: Any) -> list[str]:
+    """A tokenizer step names a tokenizer LeRobot fetches and loads (``AutoTokenizer``):
+    only the ones LeRobot's own policies name (``TOKENIZERS``)."""
+    name = config.get("tokenizer_name") if isinstance(config, dict) else None
+    if isinstance(name, str) and name in TOKENIZERS:
+        return []
+    return [
+        f"{where} names tokenizer_name {name!r}, not a tokenizer of LeRobot's own policies "
+        f"({', '.join(sorted(TOKENIZERS))}); LeRobot would fetch and load it"
+    ]
 
 
 def _plain_file(name: object) -> bool:

@@ -21,9 +21,11 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.policies.lerobot_allowed import checked_files
+from gymfg_il.files import JSON_LIMIT, WEIGHTS_LIMIT, check_regular, read_regular
+from gymfg_il.policies.lerobot_allowed import REPLACE, checked_files
 from gymfg_il.sim.properties import task_columns
 
+EITHER = "put the file `train bc` or lerobot-train wrote in its place, or train the policy again"
 STATE, ENVIRONMENT, IMAGES = (
     "observation.state",
     "observation.environment_state",
@@ -32,15 +34,29 @@ STATE, ENVIRONMENT, IMAGES = (
 
 
 def _lerobot_config(folder: Path) -> dict[str, Any] | None:
-    try:
-        data = json.loads((folder / "config.json").read_text())
-    except (OSError, ValueError):
-        return None
+    """The LeRobot config of the checkpoint in ``folder``, or None where there is none (no
+    config.json, or ours); NotRegularFileError where config.json or the weights are not
+    regular files (``gymfg_il.files``)."""
+    data = _json(folder / "config.json", EITHER)  # ours or LeRobot's: not known yet
     if not isinstance(data, dict) or "input_features" not in data or "obs_stats" in data:
         return None
-    if not (folder / "model.safetensors").is_file() or "type" not in data:
+    try:
+        check_regular(folder / "model.safetensors", WEIGHTS_LIMIT, REPLACE)
+    except FileNotFoundError:
         return None
-    return data
+    return data if "type" in data else None
+
+
+def _json(path: Path, fix: str = REPLACE) -> Any:
+    """The JSON in the regular file at ``path``; None where it is missing or not JSON."""
+    try:
+        raw = read_regular(path, JSON_LIMIT, fix)
+    except FileNotFoundError:
+        return None
+    try:
+        return json.loads(raw)
+    except ValueError:  # UnicodeDecodeError is one
+        return None
 
 
 def find_pretrained(path: Path) -> Path | None:
@@ -57,12 +73,9 @@ def lerobot_meta(folder: Path) -> dict[str, Any]:
     type, input features, and the dataset it was trained on (``dataset``, when recorded)."""
     config = _lerobot_config(folder)
     assert config is not None
-    dataset = None
-    try:
-        train = json.loads((folder / "train_config.json").read_text())
-        dataset = (train.get("dataset") or {}).get("root")
-    except (OSError, ValueError):
-        pass
+    train = _json(folder / "train_config.json")  # lerobot-train's, with the dataset's root
+    dataset = train.get("dataset") if isinstance(train, dict) else None
+    root = dataset.get("root") if isinstance(dataset, dict) else None
     features = {k: v.get("shape") for k, v in config["input_features"].items()}
     cameras = sorted(k.removeprefix(IMAGES) for k in features if k.startswith(IMAGES))
     return {
@@ -71,7 +84,7 @@ def lerobot_meta(folder: Path) -> dict[str, Any]:
         "lerobot": True,
         "input_features": features,
         "cameras": cameras,
-        "dataset": dataset,
+        "dataset": root if isinstance(root, str) else None,
     }
 
 

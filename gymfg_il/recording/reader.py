@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import gc
 import math
-import os
-import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -16,6 +14,7 @@ import orjson
 
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import GymFGError
+from gymfg_il.files import LOG_LIMIT, NotRegularFileError, read_regular
 from gymfg_il.recording.mcap_walk import Damage, magic_damage
 from gymfg_il.recording.messages import Sorter, stream
 from gymfg_il.recording.schemas import MARKS
@@ -168,26 +167,14 @@ def _clock(value: Any) -> float:
 
 def read_bytes(path: Path) -> bytes:
     """The bytes of the regular file at ``path``; LogError for anything else (a FIFO, whose
-    open would block, a device such as /dev/zero, which never ends, a folder)."""
+    open would block, a device such as /dev/zero, which never ends, a folder) or a file over
+    ``LOG_LIMIT`` (``gymfg_il.files``)."""
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+        return read_regular(path, LOG_LIMIT, "a trajectory log is one")
     except FileNotFoundError:
         raise LogError(f"no trajectory log at {path}") from None
-    except OSError as err:
-        raise LogError(f"{path} cannot be opened ({err.strerror})") from None
-    with open(fd, "rb", closefd=True) as f:
-        mode = os.fstat(fd).st_mode
-        if not stat.S_ISREG(mode):
-            raise LogError(
-                f"{path} is not a regular file (it is {_kind(mode)}); a trajectory log is one"
-            )
-        return f.read()
-
-
-def _kind(mode: int) -> str:
-    kinds = {stat.S_ISDIR: "a folder", stat.S_ISFIFO: "a FIFO", stat.S_ISCHR: "a device"}
-    kinds |= {stat.S_ISBLK: "a device", stat.S_ISSOCK: "a socket", stat.S_ISLNK: "a link"}
-    return next((what for test, what in kinds.items() if test(mode)), "not a file")
+    except NotRegularFileError as err:
+        raise LogError(str(err)) from None
 
 
 def read_log(path: Path) -> Log:

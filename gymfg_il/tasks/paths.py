@@ -58,7 +58,13 @@ def _abstract(cls: type[Task]) -> bool:
 def class_problem(path: str, found: object) -> str | None:
     """Why ``found``, the object ``path`` names, is not a task an aircraft can fly, or None."""
     if not (isinstance(found, type) and issubclass(found, Task)):
-        return f"{path!r} is {found!r}, not a Task class"
+        # its type, not its value: a record naming sys:modules printed every module
+        what = (
+            f"the class {found.__name__}"
+            if isinstance(found, type)
+            else f"a {type(found).__name__}"
+        )
+        return f"{path!r} is {what}, not a Task class; name a Task subclass as {PATH_RULE}"
     if _abstract(found):
         return (
             f"{path!r} is {found.__qualname__}, a base no aircraft can fly (it lacks an "

@@ -307,3 +307,32 @@ def test_what_each_log_gave_names_its_episodes_and_their_seeds(copy, capsys):
     assert f"(log episodes 0-{EPISODES - 1}, seeds 3-{3 + EPISODES - 1}; 0 new)" in (
         capsys.readouterr().out
     )
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    "make",
+    [
+        pytest.param(os.mkfifo, id="fifo"),
+        pytest.param(lambda p: p.symlink_to("/dev/zero"), id="dev-zero"),
+    ],
+)
+@pytest.mark.parametrize("which", ["data", "meta/episodes", "meta/info.json", "meta/stats.json"])
+def test_recover_refuses_a_dataset_file_that_is_not_a_file(copy, capsys, which, make):
+    """#52.7: a FIFO in the place of a dataset file hung recover (its open waits for a
+    writer), a link to /dev/zero read until memory ran out; now one line names the file, and
+    the dataset is left as it is."""
+    root = copy / "dataset"
+    if which in ("data", "meta/episodes"):
+        path = next((root / which).rglob("*.parquet"))
+    else:
+        path = root / which
+    path.unlink()
+    make(path)
+    before = sorted(p.name for p in copy.iterdir())
+    assert collect.main(["recover", str(copy)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "Traceback" not in err, err
+    assert str(path.relative_to(root)) in err and "not a regular file" in err, err
+    assert sorted(p.name for p in copy.iterdir()) == before
+    assert os.path.lexists(path)

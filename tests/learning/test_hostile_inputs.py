@@ -6,6 +6,7 @@ one, and a damaged dataset is one line "error: ..." with exit status 2."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -108,6 +109,45 @@ def test_eval_refuses_the_hostile_step_in_one_line(act_checkpoint, tmp_path, cap
     assert not marker.exists()
 
 
+def state_file(folder):
+    return next(p.name for p in folder.glob("*.safetensors") if p.name != "model.safetensors")
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    "make",
+    [
+        pytest.param(os.mkfifo, id="fifo"),
+        pytest.param(lambda p: p.symlink_to("/dev/zero"), id="dev-zero"),
+        pytest.param(lambda p: p.symlink_to("/dev/urandom"), id="dev-urandom"),
+    ],
+)
+@pytest.mark.parametrize(
+    "name",
+    [
+        "config.json",
+        "train_config.json",
+        "policy_preprocessor.json",
+        "policy_postprocessor.json",
+        "model.safetensors",
+        state_file,
+    ],
+)
+def test_eval_refuses_a_checkpoint_file_that_is_not_a_file(
+    act_checkpoint, tmp_path, capsys, name, make
+):
+    """#52.7: a FIFO in the place of a checkpoint's file hung eval (its open waits for a
+    writer); a link to /dev/zero or /dev/urandom read until memory ran out."""
+    folder = tmp_path / "pretrained_model"
+    shutil.copytree(act_checkpoint, folder)
+    name = name if isinstance(name, str) else name(folder)
+    (folder / name).unlink(missing_ok=True)  # lerobot-train writes train_config.json
+    make(folder / name)
+    argv = ["--policy", str(folder), "--task", "altitude", "--aircraft", "c172p"]
+    assert evaluate.main([*argv, "--episodes", "1", "--no-progress"]) == 2
+    one_error(capsys, f"{folder / name} is ")
+
+
 @pytest.mark.parametrize(
     "file, change, needle",
     [
@@ -139,6 +179,35 @@ def test_eval_refuses_the_hostile_step_in_one_line(act_checkpoint, tmp_path, cap
             lambda d: d.update(vision_backbone="get_model"),
             "vision_backbone 'get_model'",
         ),
+        (  # #52.12: with transformers installed, LeRobot would fetch the tokenizer named
+            "policy_preprocessor.json",
+            lambda d: d["steps"].append(
+                {"registry_name": "tokenizer_processor", "config": {"tokenizer_name": "/tmp/x"}}
+            ),
+            "tokenizer_name '/tmp/x'",
+        ),
+        (
+            "policy_preprocessor.json",
+            lambda d: d["steps"].append(
+                {"registry_name": "tokenizer_processor", "config": {"tokenizer_name": "me/tok"}}
+            ),
+            "tokenizer_name 'me/tok'",
+        ),
+        (
+            "policy_preprocessor.json",
+            lambda d: d["steps"].append({"registry_name": "tokenizer_processor", "config": []}),
+            "tokenizer_name None",
+        ),
+        (  # SmolVLA's and multi-task DiT's models fetch these
+            "config.json",
+            lambda d: d.update(vlm_model_name="me/vlm"),
+            "vlm_model_name 'me/vlm'",
+        ),
+        (
+            "config.json",
+            lambda d: d.update(text_encoder_name="me/clip"),
+            "text_encoder_name 'me/clip'",
+        ),
     ],
 )
 def test_names_outside_lerobots_own_policies_are_refused(
@@ -148,6 +217,28 @@ def test_names_outside_lerobots_own_policies_are_refused(
     with pytest.raises(UnsafeCheckpointError) as err:
         LeRobotAgent(folder)
     assert needle in str(err.value)
+
+
+def test_the_tokenizers_lerobots_own_policies_name_are_let_through(act_checkpoint, tmp_path):
+    from gymfg_il.policies.lerobot_allowed import checked_files
+
+    step = {
+        "registry_name": "tokenizer_processor",
+        "config": {"tokenizer_name": "google/paligemma-3b-pt-224", "max_length": 48},
+    }
+    folder = hostile(
+        act_checkpoint, tmp_path, "policy_preprocessor.json", lambda d: d["steps"].append(step)
+    )
+    assert "policy_preprocessor.json" in checked_files(folder)
+
+
+def test_ppo_says_a_lerobot_checkpoint_cannot_be_its_start(act_checkpoint, tmp_path, capsys):
+    """#52.12: ``train ppo --init`` of an ACT checkpoint said its config had "no
+    input_features"; it has them, and PPO fine-tunes GymFG's own MLP policies only."""
+    argv = ["ppo", "--init", str(act_checkpoint), "--out", str(tmp_path / "p"), "--no-progress"]
+    assert train.main(argv) == 2
+    one_error(capsys, "is a LeRobot checkpoint ('act')", "mlp, ppo", "cannot start from")
+    assert not (tmp_path / "p").exists()
 
 
 # --- train bc on damaged or non-finite datasets -------------------------------------------

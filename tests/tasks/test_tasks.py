@@ -235,3 +235,11 @@ def test_task_lookup_by_name():
     with pytest.raises(ConfigError, match="dynamic"):
         task_class("level", dynamic=True)
     assert isinstance(functools.partial(tasks.ReachStaticTargetRollTask, target=3)(), tasks.Task)
+
+
+def test_a_task_path_to_something_else_names_its_type_not_its_value():
+    """#52.12: ``sys:modules`` as a task printed all of ``sys.modules`` in the error."""
+    with pytest.raises(ConfigError) as err:
+        task_class("sys:modules")
+    assert str(err.value).startswith("'sys:modules' is a dict, not a Task class")
+    assert len(str(err.value)) < 200
