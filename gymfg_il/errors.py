@@ -32,10 +32,12 @@ class EnvStateError(GymFGError, RuntimeError):
 
 
 def join_problems(what: str, problems: list[str]) -> str:
-    """One message for all problems of one input (LeRobot's validate_frame style)."""
+    """One message for all problems of one input (LeRobot's validate_frame style): ``what``
+    names the input ("TrainConfig") or says what is wrong with it ("the dataset at X is
+    damaged")."""
     if len(problems) == 1:
         return f"{what}: {problems[0]}"
-    return f"{what} has {len(problems)} problems:\n" + "\n".join(f"  - {p}" for p in problems)
+    return f"{what} ({len(problems)} problems):\n" + "\n".join(f"  - {p}" for p in problems)
 
 
 class MixedTasksError(ConfigError):

@@ -118,5 +118,5 @@ def test_train_refuses_a_dataset_file_that_is_not_a_file(tmp_path, capsys, which
     replace(path, make)
     argv = ["bc", "--dataset", str(root), "--epochs", "1", "--out", str(tmp_path / "p")]
     assert train.main([*argv, "--no-progress"]) == 2
-    one_error(capsys, str(path.relative_to(root)))
+    one_error(capsys, str(path.relative_to(root)), "not a regular file")
     assert not (tmp_path / "p").exists()

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
-from gymfg_il.datasets.health import dataset_problems
+from gymfg_il.datasets.health import check_files, dataset_problems
 from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.verify import page_problems
 from gymfg_il.datasets.videos import decode_camera, image_key
@@ -242,6 +242,7 @@ def load_frames(root: Path, camera: str | None = None) -> Frames:
     root = Path(root)
     if not (root / "meta").is_dir() and (root / "dataset" / "meta").is_dir():
         root = root / "dataset"  # a session folder: its dataset is inside
+    check_files(root)  # a FIFO or a device in a file's place is named, not read
     if not (root / "meta" / "info.json").is_file():
         session = next((f for f in (root, root.parent) if any(f.glob("logs/*.mcap"))), None)
         raise ConfigError(

@@ -76,7 +76,14 @@ def lerobot_meta(folder: Path) -> dict[str, Any]:
     train = _json(folder / "train_config.json")  # lerobot-train's, with the dataset's root
     dataset = train.get("dataset") if isinstance(train, dict) else None
     root = dataset.get("root") if isinstance(dataset, dict) else None
-    features = {k: v.get("shape") for k, v in config["input_features"].items()}
+    given = config["input_features"]
+    if not (isinstance(given, dict) and all(isinstance(v, dict) for v in given.values())):
+        raise ConfigError(
+            f"{folder / 'config.json'}: input_features is a {type(given).__name__}, not an "
+            "object of features as lerobot-train writes it ({name: {type, shape}}); the "
+            "checkpoint is damaged or not LeRobot's: train it again"
+        )
+    features = {str(k): v.get("shape") for k, v in given.items()}
     cameras = sorted(k.removeprefix(IMAGES) for k in features if k.startswith(IMAGES))
     return {
         "type": f"lerobot:{config['type']}",

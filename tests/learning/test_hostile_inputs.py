@@ -561,3 +561,16 @@ def test_flying_a_policy_that_names_a_task_that_cannot_fly_is_one_line(
     }[entry]()
     assert code == 2
     one_error(capsys, repr(task))
+
+
+@pytest.mark.parametrize("features", [[], ["observation.state"], {"observation.state": 13}])
+def test_eval_refuses_input_features_that_are_not_features(
+    act_checkpoint, tmp_path, capsys, features
+):
+    """#52: a LeRobot config whose input_features is a list ended in an AttributeError."""
+    folder = hostile(
+        act_checkpoint, tmp_path, "config.json", lambda d: d.update(input_features=features)
+    )
+    argv = ["--policy", str(folder), "--task", "altitude", "--aircraft", "c172p"]
+    assert evaluate.main([*argv, "--episodes", "1", "--no-progress"]) == 2
+    one_error(capsys, "input_features")
