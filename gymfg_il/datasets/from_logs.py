@@ -36,7 +36,7 @@ from gymfg_il.datasets.gather import (
     no_logs,
     read_logs,
 )
-from gymfg_il.datasets.health import dataset_problems
+from gymfg_il.datasets.health import dataset_problems, stats_problems
 from gymfg_il.datasets.provenance import metadata_columns, write_columns
 from gymfg_il.datasets.verify import MARK, Checked, differences, digest
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views, episode_frames, image_key
@@ -121,6 +121,10 @@ def _check(
         if refs and all(ref in logged for ref in refs):
             return Checked([f"its info.json disagrees with the logs of its episodes ({err})"]), refs
         raise
+    names = {k: list(meta.features[k]["names"]) for k in ("observation.state", "action")}
+    stats = stats_problems(meta.stats, names)  # train bc refuses them and sends you here
+    if stats:
+        return Checked(stats), refs
     return differences(root, meta, logged, refs, records), refs
 
 

@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.files import JSON_LIMIT, PARQUET_LIMIT, VIDEO_LIMIT, regular_problem
@@ -83,4 +86,29 @@ def dataset_problems(root: Path) -> list[str]:
     total = json.loads((meta / "info.json").read_text()).get("total_frames")
     if frames != total:
         problems.append(f"the data files hold {frames} frames, meta/info.json counts {total}")
+    return problems
+
+
+def stats_problems(stats: Any, names: dict[str, list[str]]) -> list[str]:
+    """What is wrong with ``stats.json``'s mean and std of the features in ``names`` (feature
+    -> the names of its values): missing, of the wrong length, not finite, a negative std."""
+    problems = []
+    for key, labels in names.items():
+        entry = stats.get(key) if isinstance(stats, dict) else None
+        for part in ("mean", "std"):
+            try:
+                values = np.asarray(entry[part], dtype=np.float64)  # type: ignore[index]
+            except (KeyError, TypeError, ValueError):
+                problems.append(f"meta/stats.json: {key} has no {part} of numbers")
+                continue
+            if values.shape != (len(labels),):
+                problems.append(
+                    f"meta/stats.json: {key} {part} has shape {values.shape}, want ({len(labels)},)"
+                )
+                continue
+            bad = ~np.isfinite(values) | ((values < 0) if part == "std" else False)
+            problems += [
+                f"meta/stats.json: {key} {part} of {labels[i]} is {values[i]}"
+                for i in np.flatnonzero(bad)
+            ]
     return problems

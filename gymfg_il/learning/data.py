@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.datasets import lerobot_api as lr
-from gymfg_il.datasets.health import check_files, dataset_problems
+from gymfg_il.datasets.health import check_files, dataset_problems, stats_problems
 from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.verify import page_problems
 from gymfg_il.datasets.videos import decode_camera, image_key
@@ -24,7 +24,6 @@ from gymfg_il.learning.data_checks import (
     meta_problems,
     opened,
     rebuild_hint,
-    stats_problems,
 )
 
 

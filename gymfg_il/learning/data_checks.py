@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from gymfg_il.datasets.health import file_problems
+from gymfg_il.datasets.health import file_problems, stats_problems
 from gymfg_il.errors import ConfigError, GymFGError, join_problems
 
 if TYPE_CHECKING:
@@ -102,31 +102,6 @@ def column_problems(table: Any, episodes: Any, features: dict[str, Any]) -> list
             for c in ("episode_index", "length")
             if c not in episodes.column_names
         ]
-    return problems
-
-
-def stats_problems(stats: Any, names: dict[str, list[str]]) -> list[str]:
-    """What is wrong with ``stats.json``'s mean and std of the features in ``names`` (feature
-    -> the names of its values): missing, of the wrong length, not finite, a negative std."""
-    problems = []
-    for key, labels in names.items():
-        entry = stats.get(key) if isinstance(stats, dict) else None
-        for part in ("mean", "std"):
-            try:
-                values = np.asarray(entry[part], dtype=np.float64)  # type: ignore[index]
-            except (KeyError, TypeError, ValueError):
-                problems.append(f"meta/stats.json: {key} has no {part} of numbers")
-                continue
-            if values.shape != (len(labels),):
-                problems.append(
-                    f"meta/stats.json: {key} {part} has shape {values.shape}, want ({len(labels)},)"
-                )
-                continue
-            bad = ~np.isfinite(values) | ((values < 0) if part == "std" else False)
-            problems += [
-                f"meta/stats.json: {key} {part} of {labels[i]} is {values[i]}"
-                for i in np.flatnonzero(bad)
-            ]
     return problems
 
 

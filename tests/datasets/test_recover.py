@@ -336,3 +336,19 @@ def test_recover_refuses_a_dataset_file_that_is_not_a_file(copy, capsys, which, 
     assert str(path.relative_to(root)) in err and "not a regular file" in err, err
     assert sorted(p.name for p in copy.iterdir()) == before
     assert os.path.lexists(path)
+
+
+def test_statistics_that_are_not_numbers_are_rebuilt(copy, capsys):
+    """#52.11: a NaN in meta/stats.json survived recover, while train bc refused the dataset
+    and advised running recover: the advice looped."""
+    from gymfg_il import train
+
+    stats = copy / "dataset" / "meta" / "stats.json"
+    record = json.loads(stats.read_text())
+    record["observation.state"]["std"][2] = float("nan")
+    stats.write_text(json.dumps(record))
+    assert collect.main(["recover", str(copy)]) == 0
+    out = capsys.readouterr().out
+    assert "rebuilt from the logs" in out and "std of" in out
+    argv = ["bc", "--dataset", str(copy), "--epochs", "1", "--hidden", "16", "--no-progress"]
+    assert train.main([*argv, "--out", str(copy / "policy")]) == 0
