@@ -49,6 +49,11 @@ def check_out(out: Path) -> None:
     written, or that holds anything a policy's save did not write (``foreign_files``:
     replacing the folder would delete it)."""
     out = Path(out)
+    if out.is_symlink():  # saving swaps the folder in whole: the link would go, not its target
+        raise ConfigError(
+            f"--out {out} is a link (to {os.readlink(out)}); saving replaces the folder whole, "
+            f"which would replace the link: give the folder itself (--out {out.resolve()})"
+        )
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out {out} is a file; give a folder for the policy")
     if out.is_dir():

@@ -131,3 +131,18 @@ def test_a_checkpoints_folder_holding_a_users_files_is_refused(tmp_path, damage,
     with pytest.raises(ConfigError) as err:
         check_out(out)
     assert f"({named}: " in str(err.value)
+
+
+def test_an_out_that_is_a_link_is_refused_before_training(tmp_path, capsys):
+    """#52.12: `train bc --out LINK` trained, then failed to save with "free some space"."""
+    from gymfg_il import train
+
+    real = tmp_path / "real"
+    real.mkdir()
+    (tmp_path / "link").symlink_to(real)
+    sample = Path(__file__).resolve().parents[2] / "datasets/sample-altitude-c172p/dataset"
+    argv = ["bc", "--dataset", str(sample), "--epochs", "1", "--no-progress"]
+    assert train.main([*argv, "--out", str(tmp_path / "link")]) == 2
+    err = capsys.readouterr().err
+    assert "is a link" in err and f"--out {real}" in err and "training" not in err
+    assert (tmp_path / "link").is_symlink() and list(real.iterdir()) == []
