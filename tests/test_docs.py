@@ -72,6 +72,7 @@ def test_a_broken_link_fails_the_build(tmp_path):
     config = tmp_path / "mkdocs.yml"
     config.write_text(
         f"INHERIT: {ROOT / 'mkdocs.yml'}\ndocs_dir: {docs}\nplugins: [search]\nnav: [index.md]\n"
+        "hooks: []\n"
     )
     run = mkdocs_build(config, tmp_path / "site")
     assert run.returncode != 0

@@ -3,6 +3,7 @@ imports only from the layers below it, and from itself), the library never impor
 an old path kept for users (``gymfg_il.moved``), and no module is over 400 lines."""
 
 import ast
+from functools import cache
 from pathlib import Path
 
 import pytest
@@ -76,13 +77,14 @@ def test_imports_run_down_the_layers(path):
     assert not upward, f"{path.relative_to(ROOT)} (layer {own}) imports {upward} from above"
 
 
-def old_paths() -> set[str]:
+@cache  # every module's test asks; parsing the package once per test took 100 s
+def old_paths() -> frozenset[str]:
     """The modules kept only so that imports users write keep working (tiny shims)."""
-    return {
+    return frozenset(
         dotted(p)
         for p in modules()
         if "gymfg_il.moved" in imported_modules(p) and p.stem != "__main__"
-    }
+    )
 
 
 def test_the_old_paths_are_the_ones_users_were_told_about():
