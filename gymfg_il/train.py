@@ -98,8 +98,6 @@ def _ppo(args: argparse.Namespace) -> int:
     flight = start.flight
     kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
     keep = f"the kept actor the best on {kept_on}" if cfg.keep == "best" else "the last kept"
-    if cfg.average_start is not None:
-        keep = f"the kept actor the mean of those from step {cfg.average_start:,} on ({kept_on})"
     print(
         f"PPO on {flight.task_label} on {flight.aircraft} ({flight.turbulence} turbulence): "
         f"{cfg.steps:,} env steps on {cfg.n_envs} env(s), evaluated every {cfg.eval_every:,} "
@@ -125,13 +123,8 @@ def _ppo(args: argparse.Namespace) -> int:
         f"{100 * expert.success:.0f}%), return {first.mean_return:.1f} -> "
         f"{last.mean_return:.1f} (controller {expert.mean_return:.1f})"
     )
-    kept, averaged = result.kept, result.averaged
-    if averaged:
-        which = f"the mean of the {len(averaged)} actors of steps {averaged[0]:,}..{averaged[-1]:,}"
-    else:
-        which = "the actor of " + ("the start" if kept.step == 0 else f"step {kept.step:,}")
-        if cfg.keep == "average":  # the start flew better than the average
-            which += " (the average flew worse on these seeds)"
+    kept = result.kept
+    which = "the actor of " + ("the start" if kept.step == 0 else f"step {kept.step:,}")
     print(
         f"policy saved to {result.out}: {which} ({100 * kept.select_success:.0f}% success on "
         f"{kept.chosen_on} evaluation seeds; curve: {result.out / 'curve.png'})"

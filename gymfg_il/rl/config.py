@@ -51,27 +51,16 @@ class PPORunConfig:
         eval_episodes: held-out episodes each evaluation flies (seeds eval_seed, eval_seed +
             1, ...), the same every time, with the controller on them once.
         eval_seed: the first held-out seed.
-        select_episodes: episodes each evaluation flies to choose the kept actor (with
-            --keep best; with --keep average the start and the average fly them, the other
-            evaluations the curve's alone): the curve's eval_episodes seeds and the next
-            ones (seeds eval_seed .. eval_seed + select_episodes - 1), on two processes
-            (default: 64, or eval_episodes if more). On 16 episodes a success rate spreads
-            about 10 points, as much as the actors differ, and the best of twenty such draws
-            is mostly the luckiest (docs/results/rl.md). Equal to eval_episodes: chosen on
-            the curve's seeds alone.
+        select_episodes: episodes each evaluation flies to choose the kept actor (with --keep
+            best): the curve's eval_episodes seeds and the next ones (seeds eval_seed ..
+            eval_seed + select_episodes - 1), on two processes (default: 64, or
+            eval_episodes if more). Equal to eval_episodes: chosen on the curve's seeds alone.
         keep: which actor is saved: ``best``, the evaluation with the highest success (then
             return) on the select_episodes seeds, the start included, so the result never
-            flies worse than the start on these seeds; ``average``, the mean of the weights
-            of the actors evaluated from average_from of the run on (the last one included),
-            flown on the select_episodes seeds and kept unless it flies worse there than
-            the start (by success, then return; then the start is kept); or ``last``, the
-            actor as training left it.
-            Judge the result on other seeds (``eval --seed``).
-        average_from: with --keep average, the share of the run from which the evaluated
-            actors are averaged (0.5: those of its second half).
+            flies worse than the start on these seeds; or ``last``, the actor as training
+            left it. Judge the result on other seeds (``eval --seed``).
         checkpoints: keep every evaluated actor, a policy in OUT/checkpoints/step-N (about
-            0.6 MB each; with --keep average the mean too, in OUT/checkpoints/average), to
-            fly again (``eval --policy``) or choose on other seeds.
+            0.6 MB each), to fly again (``eval --policy``) or choose on other seeds.
         rollout_steps: steps each env samples between updates (PPO's n_steps).
         batch_size: samples per gradient step, a divisor of the rollout (rollout_steps x envs).
         epochs: passes over each rollout per update.
@@ -87,21 +76,11 @@ class PPORunConfig:
         clip_range: PPO's clip on the probability ratio.
         target_kl: an update stops early when its KL divergence from the sampling policy
             passes 1.5 x this (0: never).
-        exploration: how PPO explores: ``sde`` (default; stable-baselines3's generalised
-            state-dependent exploration: the noise is a linear map of the normalised
-            observation, drawn anew every sde_every steps, so the controls deviate coherently
-            for a while, which a slow aircraft's state answers) or ``gaussian`` (a new noise
-            every step).
-        sde_every: steps between new gSDE noise maps (0: one per rollout).
         action_std: the exploration noise's starting spread in the policy's normalised action
-            units (1 = the demonstrations' spread of each control).
-        action_floor: the least spread of each control (aileron, elevator, rudder, throttle;
-            raw units) in the units PPO explores and steps the actor in, which are the
-            demonstrations' spread of each control (``--action-std``): a control the
-            demonstrations hardly moved (the throttle in still air) is otherwise explored
-            and changed by that little. The starting policy flies as before (its last layer
-            is rescaled to match); default: the demonstrations' spread as it is (why:
-            docs/results/rl.md).
+            units (1 = the demonstrations' spread of each control). PPO explores with
+            stable-baselines3's generalised state-dependent exploration: the noise is a linear
+            map of the normalised observation, drawn anew every rollout, so the controls
+            deviate coherently for a while, which a slow aircraft's state answers.
         critic_warmup: env steps over which only the critic learns, the actor held, so the
             first actor updates follow a trained value function: every update on a rollout
             that began before this many steps (default: a tenth of the run, at most 20,000
@@ -110,19 +89,6 @@ class PPORunConfig:
             and a success adds this share of the episode's steps to its return (a step's task
             reward is at most about 1), so what PPO maximises includes what success measures
             (0: the task's reward alone).
-        clock: the critic sees the share of the episode flown, and the time limit ends an
-            episode's return instead of being bootstrapped past: the task is judged over its
-            last seconds and the bonus comes at the limit, so what a state is worth depends
-            on the time left (``rl.env.EpisodeClock``). The actor never sees it. Off by
-            default (why: docs/results/rl.md).
-        stall_margin_kt: each training step flown slower than the aircraft's stall speed
-            (where the task ends an episode) plus this many knots costs a step's whole task
-            reward (1): a stall otherwise costs only the reward after it, a few steps' worth
-            at PPO's discount (0: no cost; docs/results/rl.md).
-        bank_limit_deg: each training step banked beyond this many degrees either way costs
-            a step's whole task reward (1): a turn fine-tuned without it banked hard, lost
-            the altitude in its first seconds and chattered about the new heading (0: no
-            cost; the c172p's maneuvers bank 25 degrees; docs/results/rl.md).
         anchor: weight, at the start, of the squared distance between the actor's mean action
             and the starting policy's (normalised units) added to PPO's loss; it decays
             linearly to 0 over anchor_steps (0: no anchor). Not used from scratch.
@@ -147,8 +113,7 @@ class PPORunConfig:
     eval_episodes: int = 16
     eval_seed: int = 7000
     select_episodes: int | None = None
-    keep: Literal["best", "last", "average"] = "best"
-    average_from: float = 0.5
+    keep: Literal["best", "last"] = "best"
     checkpoints: bool = False
     rollout_steps: int = 512
     batch_size: int = 512
@@ -159,15 +124,9 @@ class PPORunConfig:
     gae_lambda: float | None = None
     clip_range: float = 0.2
     target_kl: float = 0.02
-    exploration: Literal["sde", "gaussian"] = "sde"
-    sde_every: int = 0
     action_std: float = 0.2
-    action_floor: tuple[float, float, float, float] | None = None
     critic_warmup: int | None = None
     success_bonus: float = 0.2
-    clock: bool = False
-    stall_margin_kt: float = 0.0
-    bank_limit_deg: float = 0.0
     anchor: float = 1.0
     anchor_steps: int | None = None
     critic: list[int] = field(default_factory=lambda: [256, 256])
@@ -195,28 +154,15 @@ class PPORunConfig:
             )
         problems += self._rollout_problems() + self._seed_problems()
         problems += filter(None, [overlap_problem(self.init, self.out)])
-        if self.sde_every < 0:
-            problems.append(f"sde_every={self.sde_every}: want 0 (once a rollout) or more")
         problems += self._rate_problems()
-        if not 0 <= self.average_from < 1:
-            problems.append(
-                f"average_from={self.average_from} must lie in [0, 1) (a share of the run)"
-            )
         if not 0 < self.clip_range < 1:
             problems.append(f"clip_range={self.clip_range} must lie in (0, 1)")
-        if not 0 <= self.bank_limit_deg < 180:
-            problems.append(f"bank_limit_deg={self.bank_limit_deg}: want 0 (off) up to 180")
-        for name in ("target_kl", "anchor", "success_bonus", "stall_margin_kt"):
+        for name in ("target_kl", "anchor", "success_bonus"):
             value = getattr(self, name)
             if not (value >= 0 and math.isfinite(value)):
                 problems.append(f"{name}={value} must be a number >= 0")
         if not (0 < self.action_std <= 10):
             problems.append(f"action_std={self.action_std} must lie in (0, 10]")
-        if self.action_floor is not None and not all(0 <= v <= 1 for v in self.action_floor):
-            problems.append(
-                f"action_floor={self.action_floor}: want four spreads in [0, 1] (raw units of "
-                "aileron, elevator, rudder, throttle)"
-            )
         for name in ("critic_warmup", "anchor_steps"):
             value = getattr(self, name)
             if value is not None and value < 0:
@@ -305,11 +251,6 @@ class PPORunConfig:
         if self.select_episodes is not None:
             return self.select_episodes
         return max(SELECT_EPISODES, self.eval_episodes)
-
-    @property
-    def average_start(self) -> int | None:
-        """With keep ``average``: the env step from which evaluated actors are averaged."""
-        return int(self.steps * self.average_from) if self.keep == "average" else None
 
     @property
     def rollout(self) -> int:

@@ -19,11 +19,7 @@ import gymnasium as gym
 import numpy as np
 
 from gymfg_il.envs.flight import FlightSpec
-from gymfg_il.sim.properties import INDEX
-from gymfg_il.sim.timing import episode_steps
 from gymfg_il.tasks.verdicts import judge_flight
-
-_AIRSPEED, _ROLL = INDEX["airspeed_kts"], INDEX["roll_deg"]
 
 
 class NormalizedActions(gym.ActionWrapper):
@@ -99,114 +95,13 @@ class SuccessBonus(gym.Wrapper):
         return success
 
 
-class StepCost(gym.Wrapper):
-    """Each step whose resulting state ``charged`` says yes to costs ``cost`` (1: about a
-    step's whole task reward); the flights subclass it with their rule."""
-
-    def __init__(self, env: gym.Env, cost: float = 1.0) -> None:
-        super().__init__(env)
-        flight: Any = env.unwrapped
-        self._flight, self._world, self.cost = flight, flight.world, cost
-
-    def charged(self, state: np.ndarray) -> bool:
-        raise NotImplementedError
-
-    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
-        obs, reward, terminated, truncated, info = self.env.step(action)
-        if self.charged(self._world.slots[0].state):
-            reward = float(reward) - self.cost
-        return obs, float(reward), terminated, truncated, info
-
-
-class StallMargin(StepCost):
-    """Each step flown slower than the aircraft's stall speed (``FlightProfile``'s
-    ``min_airspeed_kts``, where the task ends an episode as stalled) plus ``margin_kt`` costs
-    ``cost`` (1: about a step's whole task reward).
-
-    Ending an episode costs a policy only the reward it would have earned afterwards, which
-    PPO's discount (about 10 s ahead) values at a few steps' worth. A c172p fine-tuned for the
-    altitude in moderate turbulence learnt to climb at 25 degrees of pitch, bleeding 100 kt
-    to 50 in 11 s, and stalled in up to 3 of 16 held-out episodes where the BC start and the
-    controller never did (docs/results/rl.md). The cost comes while the speed is being lost,
-    within the discount's reach."""
-
-    def __init__(self, env: gym.Env, margin_kt: float, cost: float = 1.0) -> None:
-        super().__init__(env, cost)
-        self.floor_kt = self._flight.task.aircraft.profile.min_airspeed_kts + margin_kt
-
-    def charged(self, state: np.ndarray) -> bool:
-        return bool(state[_AIRSPEED] < self.floor_kt)
-
-
-class BankLimit(StepCost):
-    """Each step banked beyond ``limit_deg`` either way costs ``cost`` (1: about a step's
-    whole task reward).
-
-    The turn's reward pays for the heading turned, so a policy fine-tuned on it learnt to
-    bank hard: the altitude went in the first seconds of a steep turn, and the roll swung
-    +-30 degrees about the new heading to the end (docs/results/rl.md). The controller banks
-    25 degrees at most in the maneuvers."""
-
-    def __init__(self, env: gym.Env, limit_deg: float, cost: float = 1.0) -> None:
-        super().__init__(env, cost)
-        self.limit_deg = limit_deg
-
-    def charged(self, state: np.ndarray) -> bool:
-        return bool(abs(state[_ROLL]) > self.limit_deg)
-
-
-class EpisodeClock(gym.Wrapper):
-    """Appends the share of the episode flown (0 at the reset, 1 at the time limit) to the
-    observation, and makes the time limit the episode's end (``terminated``), not a cut.
-
-    The task judges an episode over its last seconds and the success bonus comes at the time
-    limit: what an action is worth depends on the time left, which the flight's observation
-    does not hold. With the clock the critic can value it, and since the limit is part of the
-    task, its return ends there instead of being bootstrapped past it (Pardo et al. 2018,
-    "Time Limits in Reinforcement Learning"). The actor never sees the clock
-    (``rl.policy``): it flies as the cloned policy does, from the flight's observation."""
-
-    def __init__(self, env: gym.Env, steps: int) -> None:
-        super().__init__(env)
-        self.steps = steps
-        self._t = 0
-        box = env.observation_space
-        assert isinstance(box, gym.spaces.Box)
-        self.observation_space = gym.spaces.Box(
-            np.append(box.low, 0.0).astype(box.dtype),
-            np.append(box.high, 1.0).astype(box.dtype),
-            dtype=box.dtype,
-        )
-
-    def _timed(self, obs: np.ndarray) -> np.ndarray:
-        return np.append(obs, min(1.0, self._t / self.steps)).astype(obs.dtype)
-
-    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
-        obs, info = self.env.reset(**kwargs)
-        self._t = 0
-        return self._timed(obs), info
-
-    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
-        obs, reward, terminated, truncated, info = self.env.step(action)
-        self._t += 1
-        return self._timed(obs), float(reward), terminated or truncated, False, info
-
-
 def make_env(
-    spec: dict[str, Any],
-    mean: list[float],
-    std: list[float],
-    success_bonus: float = 0.0,
-    clock: bool = False,
-    stall_margin_kt: float = 0.0,
-    bank_limit_deg: float = 0.0,
+    spec: dict[str, Any], mean: list[float], std: list[float], success_bonus: float = 0.0
 ) -> gym.Env:
     """One training env (picklable, built in its own process): the flight ``spec`` taking
     actions in the policy's normalised units, its episodes' task returns logged
-    (stable-baselines3's ``Monitor``, ``rollout/ep_rew_mean``: without the bonus or the
-    stall margin's cost), with ``success_bonus`` judged, ``stall_margin_kt`` and
-    ``bank_limit_deg`` charged (``StallMargin``, ``BankLimit``) and with ``clock`` timed
-    (``EpisodeClock``)."""
+    (stable-baselines3's ``Monitor``, ``rollout/ep_rew_mean``: without the bonus), with
+    ``success_bonus`` judged (``SuccessBonus``)."""
     from stable_baselines3.common.monitor import Monitor
 
     flight = FlightSpec.from_dict(spec)
@@ -214,10 +109,4 @@ def make_env(
     out: gym.Env = Monitor(NormalizedActions(env, np.array(mean), np.array(std)))
     if success_bonus:
         out = SuccessBonus(out, success_bonus)
-    if stall_margin_kt:
-        out = StallMargin(out, stall_margin_kt)
-    if bank_limit_deg:
-        out = BankLimit(out, bank_limit_deg)
-    if clock:
-        out = EpisodeClock(out, episode_steps(flight.episode_time_s, flight.agent_hz))
     return out

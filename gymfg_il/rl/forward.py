@@ -70,12 +70,10 @@ class NumpyActorCritic:
 
     def __init__(self, policy: Any, rng: np.random.Generator) -> None:
         self.policy, self.rng = policy, rng
-        self.use_sde = bool(policy.use_sde)
-        if self.use_sde:
-            dist = policy.action_dist
-            if dist.use_expln or not dist.full_std or dist.bijector is not None:
-                raise ValueError("the numpy pass follows gSDE with full_std and no expln/squash")
-            self.epsilon = float(dist.epsilon)
+        dist = policy.action_dist
+        if not policy.use_sde or dist.use_expln or not dist.full_std or dist.bijector is not None:
+            raise ValueError("the numpy pass follows gSDE with full_std and no expln/squash")
+        self.epsilon = float(dist.epsilon)
         self.noise: np.ndarray | None = None
         self.load(None)
 
@@ -88,36 +86,27 @@ class NumpyActorCritic:
         def stats(norm: Any) -> tuple[np.ndarray, np.ndarray]:
             return norm.mean.numpy().copy(), norm.std.numpy().copy()
 
-        self.n_actor, self.n_critic = actor.n_obs, critic.n_obs
         self.actor_norm, self.critic_norm = stats(actor.obs_norm), stats(critic.obs_norm)
         self.actor, self.critic = layers(actor.net), layers(critic.net)
-        self.std = np.exp(self.policy.log_std.detach().numpy())  # (n_obs, n_act) with gSDE
+        self.std = np.exp(self.policy.log_std.detach().numpy())  # (n_obs, n_act)
 
     def reset_noise(self, n: int) -> None:
-        """gSDE: a new noise map per env (``n`` of them); without gSDE, nothing."""
-        if self.use_sde:
-            self.noise = (self.rng.standard_normal((n, *self.std.shape)) * self.std).astype(
-                np.float32
-            )
+        """A new gSDE noise map per env (``n`` of them)."""
+        self.noise = (self.rng.standard_normal((n, *self.std.shape)) * self.std).astype(np.float32)
 
     def values(self, obs: np.ndarray) -> np.ndarray:
         """The critic's value of each observation (a batch), shape (batch,)."""
         mean, std = self.critic_norm
-        flight = (obs[:, : self.n_critic] - mean) / std
-        x = np.concatenate([flight, 2 * obs[:, self.n_critic :] - 1], axis=1)
-        return _run(self.critic, x)[:, 0]
+        return _run(self.critic, (obs - mean) / std)[:, 0]
 
     def sample(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """A sampled action and the actor's mean for each observation of a float32 batch:
         all a step needs (``score`` values a whole rollout's steps at once, afterwards)."""
         mean, std = self.actor_norm
-        z = (obs[:, : self.n_actor] - mean) / std
+        z = (obs - mean) / std
         mu = _run(self.actor, z)
-        if self.use_sde:
-            assert self.noise is not None, "reset_noise before sampling"
-            action = mu + np.matmul(z[:, None, :], self.noise)[:, 0, :]
-        else:
-            action = mu + self.rng.standard_normal(mu.shape).astype(np.float32) * self.std
+        assert self.noise is not None, "reset_noise before sampling"
+        action = mu + np.matmul(z[:, None, :], self.noise)[:, 0, :]
         return action.astype(np.float32), mu
 
     def score(
@@ -125,12 +114,9 @@ class NumpyActorCritic:
     ) -> tuple[np.ndarray, np.ndarray]:
         """The critic's value of each observation and the log-probability of each action,
         ``actions`` and ``mu`` as ``sample`` gave them for ``obs`` with the same weights."""
-        if self.use_sde:
-            mean, std = self.actor_norm
-            z = (obs[:, : self.n_actor] - mean) / std
-            scale = np.sqrt((z * z) @ (self.std * self.std) + self.epsilon)
-        else:
-            scale = np.broadcast_to(self.std, mu.shape)
+        mean, std = self.actor_norm
+        z = (obs - mean) / std
+        scale = np.sqrt((z * z) @ (self.std * self.std) + self.epsilon)
         d = (actions.astype(np.float64) - mu) / scale
         log_prob = (-0.5 * d * d - np.log(scale) - _LOG_SQRT_2PI).sum(axis=1)
         return self.values(obs), log_prob.astype(np.float32)

@@ -53,11 +53,10 @@ class PPOResult:
     controller: EvalPoint
     notes: list[str]
     kept: EvalPoint  # the saved actor's evaluation (``PPORunConfig.keep``)
-    averaged: list[int]  # the steps whose actors were averaged into it (keep average)
 
     @property
     def kept_step(self) -> int:
-        """The step of the saved actor's evaluation (the average: the last step)."""
+        """The step of the saved actor's evaluation."""
         return self.kept.step
 
 
@@ -97,9 +96,7 @@ def _train(
     # the evaluations' processes, started before the envs' (the env processes wait while an
     # evaluation flies)
     pool = Workers(min(2, len(os.sched_getaffinity(0)))) if more else Workers(1)
-    judge = Judge(
-        flight, seeds, start, scratch_dir, began, more, pool, cfg.checkpoints, cfg.average_start
-    )
+    judge = Judge(flight, seeds, start, scratch_dir, began, more, pool, cfg.checkpoints)
     try:
         controller = judge.controller()
         curve = [judge(module, 0)]
@@ -112,9 +109,6 @@ def _train(
             action["mean"].tolist(),
             action["std"].tolist(),
             cfg.success_bonus,
-            cfg.clock,
-            cfg.stall_margin_kt,
-            cfg.bank_limit_deg,
         )
         venv: Any = training_envs(env_fn, cfg.n_envs)
         venv.seed(cfg.seed)  # env k's first reset takes seed + k
@@ -142,11 +136,9 @@ def _train(
         curve.append(judge(last, model.num_timesteps, more=cfg.keep == "best"))
         if on_eval:
             on_eval(curve[-1])
-        kept, actor, averaged = choose(cfg.keep, judge, curve, last)
+        kept, actor = choose(cfg.keep, judge, curve, last)
         seconds = time.perf_counter() - began
-        result = PPOResult(
-            out, model.num_timesteps, seconds, curve, controller, start.notes, kept, averaged
-        )
+        result = PPOResult(out, model.num_timesteps, seconds, curve, controller, start.notes, kept)
         _save(cfg, result, start, actor, scratch_dir)
         return result
     finally:
@@ -246,7 +238,6 @@ def make_model(
     """stable-baselines3's PPO with the cloned actor, the critic warm-up and the anchor, for
     a flight at ``agent_hz`` (the discount's rate)."""
     gamma, gae_lambda = cfg.discounts(agent_hz)
-    sde = cfg.exploration == "sde"
     # gSDE's noise on one control sums one term per observed variable (each of about unit
     # spread, normalised): its spread is about sqrt(n) x the matrix's
     sde_features = module.n_obs
@@ -262,15 +253,13 @@ def make_model(
         clip_range=cfg.clip_range,
         target_kl=cfg.target_kl or None,
         ent_coef=0.0,
-        use_sde=sde,
-        sde_sample_freq=cfg.sde_every or -1,
+        use_sde=True,
+        sde_sample_freq=-1,  # a new noise map per rollout
         policy_kwargs={
             "start": module,
             "critic": list(cfg.critic),
             "actor_lr_scale": cfg.actor_rate / cfg.lr,
-            "log_std_init": math.log(cfg.action_std / math.sqrt(sde_features))
-            if sde
-            else math.log(cfg.action_std),
+            "log_std_init": math.log(cfg.action_std / math.sqrt(sde_features)),
             "ortho_init": False,
         },
         tensorboard_log=str(tensorboard),
@@ -347,7 +336,6 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, scratc
             "which": cfg.keep,
             "step": result.kept_step,
             "chosen_on": result.kept.chosen_on,
-            "averaged": result.averaged,
             "select_success": result.kept.select_success,
         },
         "wall_s": round(result.seconds, 1),
@@ -373,11 +361,7 @@ def _save(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, scratc
             )
             (folder / "curve.json").write_text(json.dumps(rl, indent=1))
             title = f"{name}: {flight.task_label} on {flight.aircraft}"
-            n = len(result.averaged)
-            label = f"kept: mean of {n} ({result.kept.chosen_on} seeds)" if n else "kept"
-            plot_curve(
-                result.curve, result.controller, title, folder / "curve.png", result.kept, label
-            )
+            plot_curve(result.curve, result.controller, title, folder / "curve.png", result.kept)
             for part in ("tensorboard", "checkpoints"):
                 if (scratch / part).is_dir():
                     shutil.copytree(scratch / part, folder / part)

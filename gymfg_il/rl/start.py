@@ -33,27 +33,8 @@ class Start:
 
 def starting_policy(cfg: PPORunConfig) -> Start:
     """The actor to start from (``cfg.init``'s, or a fresh MLP) and the flight to train in;
-    a clear error for a policy that is not an MLP or a task or aircraft not its own. With
-    ``cfg.action_floor``, its action units are widened (``widen_actions``)."""
-    start = scratch_policy(cfg) if cfg.init is None else _cloned(cfg)
-    if cfg.action_floor is not None:
-        widen_actions(start.module, cfg.action_floor)
-    return start
-
-
-def widen_actions(module: Any, floor: tuple[float, ...]) -> None:
-    """Give each control a spread of at least ``floor`` (raw units, per control) in the
-    actor's normalised action units, flying as before: the last layer's outputs shrink by
-    as much as the spread grows. PPO explores and steps in those units, so a control the
-    demonstrations hardly moved (the throttle in still air) is no longer held nearly still."""
-    norm = module.action_norm
-    with torch.no_grad():
-        wider = torch.maximum(norm.std, torch.as_tensor(floor, dtype=norm.std.dtype))
-        shrink = norm.std / wider
-        last = module.net[-1]
-        last.weight.mul_(shrink[:, None])
-        last.bias.mul_(shrink)
-        norm.std.copy_(wider)
+    a clear error for a policy that is not an MLP or a task or aircraft not its own."""
+    return scratch_policy(cfg) if cfg.init is None else _cloned(cfg)
 
 
 def _cloned(cfg: PPORunConfig) -> Start:
