@@ -29,9 +29,9 @@ from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.policies.modeling_mlp import MLPPolicy
 from gymfg_il.rl.config import PPORunConfig
-from gymfg_il.rl.env import make_env
-from gymfg_il.rl.run import make_model
-from gymfg_il.rl.sampling import install, sample_rollout, sampling_copy, step_env
+from gymfg_il.rl.envs import make_env
+from gymfg_il.rl.grouped.sampling import install, sample_rollout, sampling_copy, step_env
+from gymfg_il.rl.model import make_model
 
 STEPS = 2000  # steps of each env a round
 

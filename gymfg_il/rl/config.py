@@ -97,6 +97,12 @@ class PPORunConfig:
         critic: hidden widths of the critic (value network).
         hidden: hidden widths of the actor, from scratch (with --init: the policy's own).
         device: cpu or cuda (the networks are small: cpu is usually faster).
+        sampler: how rollouts are sampled: ``grouped``, in the env processes, one per core,
+            each sampling its envs' actions from a copy of the policy (``rl.grouped``;
+            ``python -m benchmarks.rl`` measures it), or ``sb3``, stable-baselines3's own
+            loop (one process per env, the policy run in the trainer between steps). Both
+            sample the same policy; their noise is drawn by different generators, so a seed
+            flies another run on each.
     """
 
     init: Path | None = None
@@ -132,6 +138,7 @@ class PPORunConfig:
     critic: list[int] = field(default_factory=lambda: [256, 256])
     hidden: list[int] = field(default_factory=lambda: [256, 256])
     device: str = "cpu"
+    sampler: Literal["grouped", "sb3"] = "grouped"
 
     def __post_init__(self) -> None:
         typed = type_problems(self)

@@ -41,8 +41,8 @@ def test_the_actor_starts_as_the_cloned_policy(bc_policy, tmp_path):
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     from gymfg_il.policies.agent import PolicyAgent
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.run import make_model
+    from gymfg_il.rl.envs import make_env
+    from gymfg_il.rl.model import make_model
     from gymfg_il.rl.start import starting_policy, stats_of
 
     cfg = _short(bc_policy, tmp_path / "ppo")
@@ -60,7 +60,7 @@ def test_the_actor_starts_as_the_cloned_policy(bc_policy, tmp_path):
             mean = model.policy.get_distribution(batch).distribution.mean
             assert torch.equal(mean, bc.policy(batch))  # bit for bit, normalised
             normalised, _ = model.policy.predict(obs, deterministic=True)
-            raw = venv.envs[0].env.action(normalised)  # Monitor(NormalizedActions(env))
+            raw = venv.envs[0].env.action(normalised)  # Monitor(TransformAction(env))
             np.testing.assert_allclose(raw, np.clip(bc.act(obs), *_bounds(env)), atol=1e-5)
         env.close()
     finally:
@@ -157,8 +157,8 @@ def _flight(bc_policy):
 def test_the_critic_warms_up_before_the_actor_moves(bc_policy, tmp_path):
     from stable_baselines3.common.vec_env import DummyVecEnv
 
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.run import make_model
+    from gymfg_il.rl.envs import make_env
+    from gymfg_il.rl.model import make_model
     from gymfg_il.rl.start import starting_policy, stats_of
 
     cfg = PPORunConfig(
@@ -261,7 +261,7 @@ def test_train_bc_does_not_offer_ppo():
 
 def test_the_success_bonus_follows_the_verdict_eval_gives(bc_policy):
     from gymfg_il.evaluation.runner import evaluate
-    from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.envs import make_env
     from gymfg_il.rl.start import starting_policy
     from gymfg_il.rollout.agents import AgentSpec
 

@@ -17,10 +17,10 @@ from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.policies.modeling_mlp import MLPPolicy
 from gymfg_il.rl.config import PPORunConfig
-from gymfg_il.rl.env import make_env
-from gymfg_il.rl.forward import NumpyActorCritic
-from gymfg_il.rl.run import make_model
-from gymfg_il.rl.sampling import sampling_copy
+from gymfg_il.rl.envs import make_env
+from gymfg_il.rl.grouped.forward import NumpyActorCritic
+from gymfg_il.rl.grouped.sampling import sampling_copy
+from gymfg_il.rl.model import make_model
 
 
 def _policy(tmp_path):
