@@ -47,22 +47,40 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _ppo_parser(sub: Any) -> None:
+    """``ppo``'s flags in groups: the run, the flight, the evaluations, PPO's own (their
+    defaults per task from ``rl/hyperparams.toml``)."""
     from gymfg_il import cli
+    from gymfg_il.envs.options import TASK_OWN_TIME, FlightOptions, unset_values
+    from gymfg_il.rl import hyperparams
     from gymfg_il.rl.config import PPORunConfig
 
     ppo = sub.add_parser(
         "ppo",
         help="fine-tune a cloned MLP policy by RL (PPO, stable-baselines3), or train from scratch",
         description="Fine-tune a cloned MLP policy with PPO (stable-baselines3) in its own "
-        "flight, in the weather the flags give: the actor starts as the policy, the critic "
-        "is warmed up first, and a decaying anchor keeps the first updates near the start. "
+        "flight, or learn one from scratch: the actor starts as the policy, the critic is "
+        "warmed up first, and a decaying anchor keeps the first updates near the start. "
         "Evaluates on held-out seeds every --eval-every steps (the start and the controller "
         "too) and saves a ppo policy (config.json, model.safetensors) that eval, collect "
         "dagger and --assist fly, with curve.png, curve.json and a TensorBoard log. Needs the "
         "rl extra: pip install -e '.[rl]'.",
     )
-    cli.add_fields(ppo, PPORunConfig)
+    run = ("init", "steps", "out", "envs", "seed", "sampler", "device", "hidden")
+    cli.add_fields(ppo, PPORunConfig, only=run)
     ppo.add_argument("--no-progress", action="store_true", help="no progress bar")
+    flight = ppo.add_argument_group("the flight (with --init, left out: the policy's own)")
+    unset = {**unset_values(), "episode_time_s": TASK_OWN_TIME}
+    options = tuple(f.name for f in dataclasses.fields(FlightOptions))
+    shown = {k: f"the policy's; from scratch {v}" for k, v in unset.items()}
+    shown |= dict.fromkeys(("task", "aircraft"), "the policy's; from scratch, give it")
+    cli.add_fields(typing.cast(Any, flight), PPORunConfig, only=options, shown=shown)
+    evaluation = ppo.add_argument_group("evaluations")
+    judged = ("eval_every", "eval_episodes", "eval_seed", "select_episodes", "keep", "checkpoints")
+    cli.add_fields(typing.cast(Any, evaluation), PPORunConfig, only=judged)
+    own = ppo.add_argument_group("PPO's own (defaults per task: gymfg_il/rl/hyperparams.toml)")
+    table = hyperparams.table(None)
+    shown = {k: f"{v}, or the task's in hyperparams.toml" for k, v in table.items()}
+    cli.add_fields(typing.cast(Any, own), PPORunConfig, only=hyperparams.NAMES, shown=shown)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -95,16 +113,7 @@ def _ppo(args: argparse.Namespace) -> int:
     start = starting_policy(cfg)
     for note in start.notes:
         print(note, file=sys.stderr)
-    flight = start.flight
-    kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
-    keep = f"the kept actor the best on {kept_on}" if cfg.keep == "best" else "the last kept"
-    print(
-        f"PPO on {flight.task_label} on {flight.aircraft} ({flight.turbulence} turbulence): "
-        f"{cfg.steps:,} env steps on {cfg.n_envs} env(s), evaluated every {cfg.eval_every:,} "
-        f"on seeds {cfg.eval_seed}..{cfg.eval_seed + cfg.eval_episodes - 1} (the curve), "
-        f"{keep}",
-        file=sys.stderr,
-    )
+    print(ppo_plan(cfg, start.flight), file=sys.stderr)
     bar = cli.progress_bar(cfg.steps, "env steps", "step", not args.no_progress)
 
     def on_eval(point: Any) -> None:
@@ -130,6 +139,26 @@ def _ppo(args: argparse.Namespace) -> int:
         f"{kept.chosen_on} evaluation seeds; curve: {result.out / 'curve.png'})"
     )
     return 0
+
+
+def ppo_plan(cfg: Any, flight: Any) -> str:
+    """What a ``train ppo`` run will do, in a line: the flight and its air, the steps and
+    envs, how many of them the actor learns from, the evaluations and the kept actor."""
+    air = "still air" if flight.turbulence == "none" else f"{flight.turbulence} turbulence"
+    if flight.wind_kt:
+        air += f" and a {flight.wind_kt:g} kt wind"
+    last = cfg.eval_seed + cfg.eval_episodes - 1
+    when = f"every {cfg.eval_every:,} env steps" if cfg.eval_every < cfg.steps else "at the start"
+    kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
+    sampled = -(-cfg.steps // cfg.rollout) * cfg.rollout  # whole rollouts
+    keep = f"the kept actor the best on seeds {kept_on}" if cfg.keep == "best" else "the last kept"
+    return (
+        f"PPO on {flight.task_label} on {flight.aircraft} in {air}: {cfg.steps:,} env steps on "
+        f"{cfg.n_envs} env(s); the critic alone learns from the first "
+        f"{sampled - cfg.actor_steps:,}, the actor too from the next {cfg.actor_steps:,}; "
+        f"evaluated {when} and at the end on "
+        f"seeds {cfg.eval_seed}..{last} (the curve), {keep}"
+    )
 
 
 def _bc(args: argparse.Namespace) -> int:

@@ -4,6 +4,7 @@ MLP policy in its own flight, or learning from scratch. Needs the ``rl`` extra.
 Laid out along stable-baselines3's lines:
 
 - ``config``: the run's settings (``PPORunConfig``: the flight options, the run, PPO's own);
+  ``hyperparams`` and ``hyperparams.toml``, PPO's own settings per task;
 - ``algorithm``: what the fine-tuning changes in PPO (``FineTunePPO``: the critic's warm-up,
   the actor's ramp, the anchor); ``model``, the model a run trains (``make_model``);
 - ``policy``: the actor-critic around the cloned MLP (``AnchoredPolicy``);

@@ -19,7 +19,7 @@ def make_model(
 ) -> FineTunePPO:
     """stable-baselines3's PPO with the cloned actor ``module``, the critic warm-up and the
     anchor, on ``venv``, for a flight at ``agent_hz`` (the discount's rate)."""
-    gamma, gae_lambda = cfg.discounts(agent_hz)
+    ppo, (gamma, gae_lambda) = cfg.ppo, cfg.discounts(agent_hz)
     algorithm = GroupedPPO if cfg.sampler == "grouped" else FineTunePPO
     # gSDE's noise on one control sums one term per observed variable (each of about unit
     # spread, normalised): its spread is about sqrt(n) x the matrix's
@@ -27,22 +27,22 @@ def make_model(
     model = algorithm(
         AnchoredPolicy,
         venv,
-        learning_rate=cfg.lr,
-        n_steps=cfg.rollout_steps,
-        batch_size=cfg.batch_size,
-        n_epochs=cfg.epochs,
+        learning_rate=ppo.lr,
+        n_steps=ppo.rollout_steps,
+        batch_size=ppo.batch_size,
+        n_epochs=ppo.epochs,
         gamma=gamma,
         gae_lambda=gae_lambda,
-        clip_range=cfg.clip_range,
-        target_kl=cfg.target_kl or None,
+        clip_range=ppo.clip_range,
+        target_kl=ppo.target_kl or None,
         ent_coef=0.0,
         use_sde=True,
         sde_sample_freq=-1,  # a new noise map per rollout
         policy_kwargs={
             "start": module,
-            "critic": list(cfg.critic),
-            "actor_lr_scale": cfg.actor_rate / cfg.lr,
-            "log_std_init": math.log(cfg.action_std / math.sqrt(sde_features)),
+            "critic": list(ppo.critic),
+            "actor_lr_scale": cfg.actor_rate / ppo.lr,
+            "log_std_init": math.log(ppo.action_std / math.sqrt(sde_features)),
             "ortho_init": False,
         },
         tensorboard_log=str(tensorboard),
@@ -52,6 +52,6 @@ def make_model(
     )
     model.warmup, model.span = cfg.warmup_steps, cfg.anchor_span
     model.ramp = cfg.warmup_steps if cfg.init is not None else 0
-    model.actor_scale = cfg.actor_rate / cfg.lr
-    model.anchor = cfg.anchor if cfg.init is not None else 0.0  # from scratch: nothing to keep
+    model.actor_scale = cfg.actor_rate / ppo.lr
+    model.anchor = ppo.anchor if cfg.init is not None else 0.0  # from scratch, nothing to keep
     return model

@@ -108,7 +108,7 @@ def _learn(cfg: PPORunConfig, start: Start, callback: Any, tensorboard: Path) ->
         flight.to_dict(),
         action["mean"].tolist(),
         action["std"].tolist(),
-        cfg.success_bonus,
+        cfg.ppo.success_bonus,
     )
     venv = training_envs(env_fn, cfg.n_envs, cfg.sampler)
     venv.seed(cfg.seed)  # env k's first reset takes seed + k

@@ -46,12 +46,14 @@ def save_run(cfg: PPORunConfig, result: PPOResult, start: Start, actor: Any, scr
     from gymfg_il.policies.checkpoint_folder import staged
 
     module = as_ppo(actor)
-    check_diverged(module, f"lr={cfg.lr}", fix="lower --lr (default 3e-4)")
+    check_diverged(module, f"lr={cfg.ppo.lr}", fix="lower --lr (default 3e-4)")
     flight = start.flight
     name = Path(result.out).name
     settings = {k: str(v) if isinstance(v, Path) else v for k, v in asdict(cfg).items()}
+    settings |= asdict(cfg.ppo)  # PPO's settings as applied: given, else hyperparams.toml's
     settings["gamma"], settings["gae_lambda"] = cfg.discounts(flight.agent_hz)
     settings["actor_lr"] = cfg.actor_rate
+    settings["critic_warmup"], settings["anchor_steps"] = cfg.warmup_steps, cfg.anchor_span
     rl = {
         "algorithm": "ppo (stable-baselines3)",
         "init": str(cfg.init) if cfg.init else None,

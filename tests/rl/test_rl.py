@@ -148,6 +148,21 @@ def test_a_seeded_run_repeats(bc_policy, tmp_path):
     assert not all(torch.equal(runs[0][k], start[k]) for k in start)  # the actor learnt
 
 
+def test_stable_baselines3s_own_sampler_trains_the_same_way(bc_policy, tmp_path):
+    from safetensors.torch import load_file
+
+    from gymfg_il.rl.run import train_ppo
+
+    cfg = _short(bc_policy, tmp_path / "sb3", sampler="sb3", eval_every=10_000, keep="last")
+    result = train_ppo(cfg)
+    assert [p.step for p in result.curve] == [0, 1024] and result.steps == 1024
+    saved = load_file(str(tmp_path / "sb3" / "model.safetensors"))
+    start = load_file(str(bc_policy / "model.safetensors"))
+    assert not all(torch.equal(saved[k], start[k]) for k in start)  # the actor learnt
+    settings = json.loads((tmp_path / "sb3" / "config.json").read_text())["rl"]["settings"]
+    assert settings["sampler"] == "sb3" and settings["batch_size"] == 128
+
+
 def _flight(bc_policy):
     from gymfg_il.rl.start import starting_policy
 
@@ -199,7 +214,7 @@ def test_a_fine_tuned_actor_learns_at_a_third_of_the_critics_rate(bc_policy):
     assert PPORunConfig(init=bc_policy).actor_rate == 1e-4
     assert PPORunConfig(init=bc_policy, actor_lr=3e-4).actor_rate == 3e-4
     scratch = PPORunConfig(task="altitude", aircraft="c172p")
-    assert scratch.actor_rate == scratch.lr == 3e-4  # a fresh actor has nothing to keep
+    assert scratch.actor_rate == scratch.ppo.lr == 3e-4  # a fresh actor has nothing to keep
 
 
 def test_the_discount_looks_as_far_ahead_in_seconds_at_every_rate(bc_policy):
