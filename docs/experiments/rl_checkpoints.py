@@ -13,7 +13,7 @@ held-out success of the actor each rule keeps: the best on the curve's 16 seeds,
 select_episodes seeds (``train ppo``'s choice), on the CHECK seeds, the best held out (the
 ceiling no rule can pass), and the mean of the weights of the actors from --average-from of
 the run on (what ``train ppo --keep average`` kept, an option since removed, flown the same
-way). The results: docs/results/rl.md.
+way). The results: docs/experiments/rl-sessions.md (tenth and eleventh sessions).
 """
 
 from __future__ import annotations

@@ -1,13 +1,14 @@
 """One env process's share of ``train ppo``'s sampling, in this process: ``N`` c172p altitude
-envs (10 Hz) sampled by the numpy policy (``rl.sampling.sample_rollout``, a fresh MLP), beside
-a bare JSBSim loop of the same agent steps (``benchmarks.physics.raw_loop``), three rounds;
-with ``--profile``, cProfile's top functions of one more rollout; with ``--parts``, the time
-of each part of the loop's step (the actor's pass, the clip, the envs' steps, the rest),
-measured inside the loop, and the same loop with a fixed action in place of the actor.
+envs (10 Hz) sampled by the numpy policy (``rl.grouped.sampling.sample_rollout``, a fresh
+MLP), beside a bare JSBSim loop of the same agent steps (``benchmarks.physics.raw_loop``),
+three rounds; with ``--profile``, cProfile's top functions of one more rollout; with
+``--parts``, the time of each part of the loop's step (the actor's pass, the clip, the envs'
+steps, the rest), measured inside the loop, and the same loop with a fixed action in place of
+the actor.
 
     PYTHONPATH=. python docs/experiments/rl_sampling_profile.py [--envs 4] [--profile] [--parts]
 
-The results: docs/results/rl.md, Speed.
+The results: docs/experiments/rl-sessions.md, Speed.
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
-"""A cloned MLP as stable-baselines3's actor-critic, for PPO fine-tuning (``rl.run``).
+"""A cloned MLP as stable-baselines3's actor-critic, for PPO fine-tuning (``rl.model``).
 
 The actor *is* the MLP policy (``policies.modeling_mlp``): the same network and the same
 normalisation, its output the mean of PPO's Gaussian, in the MLP's normalised action units.
-The env takes actions in those units (``rl.env.NormalizedActions``), so before any
+The env takes actions in those units (``rl.envs.normalized_actions``), so before any
 update PPO's mean action is, bit for bit, the action the cloned policy flies.
 
 Two things keep the first updates from undoing the cloning:
@@ -11,7 +11,7 @@ Two things keep the first updates from undoing the cloning:
 - an anchor: every optimiser step adds the gradient of ``anchor_weight`` x the mean squared
   distance between the actor's mean and the frozen starting policy's on the minibatch's
   observations (a BC term toward the start; for Gaussians of one fixed spread, their KL
-  divergence up to a constant). ``rl.run`` decays the weight to zero over the run.
+  divergence up to a constant). ``rl.algorithm`` decays the weight to zero over the run.
 
 The anchor enters through the optimiser (``AnchoredAdam``) because stable-baselines3's PPO
 sums a fixed set of losses; its gradient is added after PPO's own gradient clipping.
