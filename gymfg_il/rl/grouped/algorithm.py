@@ -4,7 +4,7 @@ buffer as its own ``collect_rollouts`` fills it.
 
 It calls stable-baselines3's private members (``_last_obs``, ``_last_episode_starts``,
 ``_update_info_buffer``, ``VecNormalize._update_reward``), read in 2.9: the project pins that
-minor version, and ``tests/rl/grouped/test_matches_sb3.py`` holds the buffer it fills to the one
+minor version, and ``tests/rl/grouped/test_rollouts.py`` holds the buffer it fills to the one
 stable-baselines3's own loop fills on the same seeds.
 """
 
