@@ -12,7 +12,11 @@ import dataclasses
 import sys
 import typing
 from importlib.util import find_spec
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from gymfg_il.envs.flight import FlightSpec
+    from gymfg_il.rl.config import PPORunConfig
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -141,7 +145,7 @@ def _ppo(args: argparse.Namespace) -> int:
     return 0
 
 
-def ppo_plan(cfg: Any, flight: Any) -> str:
+def ppo_plan(cfg: PPORunConfig, flight: FlightSpec) -> str:
     """What a ``train ppo`` run will do, in a line: the flight and its air, the steps and
     envs, how many of them the actor learns from, the evaluations and the kept actor."""
     air = "still air" if flight.turbulence == "none" else f"{flight.turbulence} turbulence"
@@ -151,7 +155,9 @@ def ppo_plan(cfg: Any, flight: Any) -> str:
     when = f"every {cfg.eval_every:,} env steps" if cfg.eval_every < cfg.steps else "at the start"
     kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
     sampled = -(-cfg.steps // cfg.rollout) * cfg.rollout  # whole rollouts
-    keep = f"the kept actor the best on seeds {kept_on}" if cfg.keep == "best" else "the last kept"
+    keep = "the last actor kept"
+    if cfg.keep == "best":
+        keep = f"the kept actor the best on seeds {kept_on}"
     return (
         f"PPO on {flight.task_label} on {flight.aircraft} in {air}: {cfg.steps:,} env steps on "
         f"{cfg.n_envs} env(s); the critic alone learns from the first "

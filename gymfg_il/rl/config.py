@@ -140,10 +140,12 @@ class PPORunConfig(FlightOptions):
             raise ConfigError(join_problems("train ppo", typed))
         self.init = None if self.init is None else Path(self.init)
         given = {n: getattr(self, n) for n in hyperparams.NAMES if getattr(self, n) is not None}
-        self._ppo = PPOSettings(**{**hyperparams.table(self.ppo_task), **given})
+        self._ppo = hyperparams.resolve(self.ppo_task, given)
         problems = self._run_problems() + self.ppo.problems()
-        if not problems:  # the counts the rest divide by are sound
-            problems += self._rollout_problems() + self._seed_problems()
+        if self.envs >= 0:
+            problems += self._seed_problems()
+        if not problems:  # the counts a rollout is made of are sound
+            problems += self._rollout_problems()
         if problems:
             raise ConfigError(join_problems("train ppo", problems))
 

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.typecheck import type_problems
 
 HYPERPARAMS = Path(__file__).with_name("hyperparams.toml")
 
@@ -101,3 +102,18 @@ def table(task: str | None, path: Path | None = None) -> dict[str, Any]:
         raise ConfigError(f"{path}: " + "; ".join(problems))
     own = data.get(task, {}) if task else {}
     return {**data["default"], **own}
+
+
+def resolve(task: str | None, given: dict[str, Any]) -> PPOSettings:
+    """PPO's settings for a run of ``task``: ``given`` (the flags), else the task's in
+    ``HYPERPARAMS``; a value of the wrong type (from the file) is an error naming it."""
+    values = {**table(task), **given}
+    required = [f.name for f in dataclasses.fields(PPOSettings) if f.default is dataclasses.MISSING]
+    missing = [name for name in required if name not in values]
+    if missing:
+        raise ConfigError(f"{HYPERPARAMS}: [default] lacks {', '.join(missing)}")
+    settings = PPOSettings(**values)
+    typed = type_problems(settings)
+    if typed:
+        raise ConfigError(f"PPO's settings (given, or in {HYPERPARAMS}): " + "; ".join(typed))
+    return settings

@@ -94,8 +94,9 @@ def test_ppos_settings_come_from_the_tasks_table_and_the_flags_win(
 ):
     assert hyperparams.table(None) == hyperparams.table("altitude")  # no table of its own
     assert hyperparams.table(None)["batch_size"] == 512
+    original = hyperparams.HYPERPARAMS.read_text()
     own = tmp_path / "hyperparams.toml"
-    own.write_text(hyperparams.HYPERPARAMS.read_text() + "\n[altitude]\nbatch_size = 256\n")
+    own.write_text(original + "\n[altitude]\nbatch_size = 256\n")
     monkeypatch.setattr(hyperparams, "HYPERPARAMS", own)
     # the policy flies the altitude: its table's batch, the rest the default's
     cfg = PPORunConfig(init=bc_policy, envs=2)
@@ -105,3 +106,6 @@ def test_ppos_settings_come_from_the_tasks_table_and_the_flags_win(
     own.write_text("[default]\nbatch_size = 256\nlearning_rate = 1e-3\n")
     with pytest.raises(ConfigError, match=r"\[default\] learning_rate: no setting of PPO's"):
         hyperparams.table("altitude")
+    own.write_text(original.replace("epochs = 10", 'epochs = "ten"'))
+    with pytest.raises(ConfigError, match=r"epochs='ten': want int"):
+        PPORunConfig(init=bc_policy, envs=2)
