@@ -1,13 +1,14 @@
 """RL sampling (``train ppo``): stable-baselines3's PPO collecting rollouts (policy inference
-included) from N envs in one process per core, each sampling its envs' actions itself
-(``rl.vec``, as ``train ppo`` runs them, the policy as numpy functions: ``rl.forward``),
-against the physics it cannot beat: min(N, cores) bare JSBSim loops doing the same agent
-steps (c172p altitude, 10 Hz = 12 JSBSim frames). Beside it, in the same rounds, the ceiling
-any sampler has here: the same training envs in as many processes, sampled by the same loop
-(``rl.sampling.sample_rollout``) with a fixed action, no policy at all
-(``rl_envs_alone_vs_physics_bound``, reported).
+included) from N envs with the grouped sampler, in one process per core, each sampling its
+envs' actions itself (``rl.grouped``, as ``train ppo`` runs them by default, the policy as
+numpy functions), against the physics it cannot beat: min(N, cores) bare JSBSim loops doing
+the same agent steps (c172p altitude, 10 Hz = 12 JSBSim frames). Beside it, in the same
+rounds, the ceiling any sampler has here: the same training envs in as many processes,
+sampled by the same loop (``rl.grouped.sampling.sample_rollout``) with a fixed action, no
+policy at all (``rl_envs_alone_vs_physics_bound``, reported). ``--sampler sb3`` measures
+stable-baselines3's own loop instead (``train ppo --sampler sb3``; its rows end in ``_sb3``).
 
-    python -m benchmarks.rl [--envs 2 8 16]
+    python -m benchmarks.rl [--envs 2 8 16] [--sampler sb3]
 """
 
 from __future__ import annotations
@@ -23,9 +24,9 @@ from benchmarks.common import Row, print_rows
 from benchmarks.physics import raw_loop
 
 
-def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
-    """(collect about ``steps`` env steps with PPO's own rollout loop, close) for PPO around
-    a fresh MLP on ``n_envs`` envs, grouped in one process per core as ``train ppo`` runs them."""
+def sampler(n_envs: int, kind: str = "grouped") -> tuple[Callable[[int], None], Callable[[], None]]:
+    """(collect about ``steps`` env steps with PPO's rollout loop, close) for PPO around a
+    fresh MLP on ``n_envs`` envs, sampled as ``train ppo --sampler KIND`` samples them."""
     import tempfile
     from functools import partial
 
@@ -36,9 +37,8 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     from gymfg_il.policies.configuration_mlp import MLPConfig
     from gymfg_il.policies.modeling_mlp import MLPPolicy
     from gymfg_il.rl.config import PPORunConfig
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.run import make_model
-    from gymfg_il.rl.vec import training_envs
+    from gymfg_il.rl.envs import make_env, training_envs
+    from gymfg_il.rl.model import make_model
 
     flight = FlightSpec.solo("c172p", "altitude")
     env = flight.make_env()
@@ -47,10 +47,12 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     stats = [{"mean": np.zeros(n), "std": np.ones(n)} for n in (n_obs, 4)]
     module = MLPPolicy(MLPConfig(), *stats)
     env_fn = partial(make_env, flight.to_dict(), [0.0] * 4, [1.0] * 4, 0.2)
-    venv = training_envs(env_fn, n_envs)
+    venv = training_envs(env_fn, n_envs, kind)
     venv.seed(0)
     venv = VecNormalize(venv, norm_obs=False, norm_reward=True)
-    cfg = PPORunConfig(init=Path("unused"), envs=n_envs, rollout_steps=64, batch_size=64)
+    cfg = PPORunConfig(
+        init=Path("unused"), envs=n_envs, rollout_steps=64, batch_size=64, sampler=kind
+    )
     model = make_model(cfg, venv, module, Path(tempfile.mkdtemp()), "cpu", flight.agent_hz)
     model.tensorboard_log = None
     _, callback = model._setup_learn(10**9, callback=None)
@@ -65,8 +67,8 @@ def sampler(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
 
 
 class _FixedActions:
-    """``rl.sampling.sample_rollout``'s policy with no network: the same action for every env
-    at every step, values and log-probabilities 0."""
+    """``rl.grouped.sampling.sample_rollout``'s policy with no network: the same action for
+    every env at every step, values and log-probabilities 0."""
 
     action = (0.0, 0.0, 0.0, 0.75)
 
@@ -93,11 +95,11 @@ class _FixedActions:
 
 def _stepper(remote: Any, env_fn: Callable[[], Any], n: int, first_seed: int) -> None:
     """An env process with no policy: ``n`` envs from ``env_fn`` sampled by
-    ``rl.sampling.sample_rollout`` (the loop ``train ppo``'s env processes run) with a fixed
+    ``rl.grouped.sampling.sample_rollout`` (the loop ``train ppo``'s env processes run) with a fixed
     action, ``k`` steps each time it is sent ``k``; None ends it."""
     import numpy as np
 
-    from gymfg_il.rl.sampling import sample_rollout
+    from gymfg_il.rl.grouped.sampling import sample_rollout
 
     envs = [env_fn() for _ in range(n)]
     obs = np.stack([env.reset(seed=first_seed + i)[0] for i, env in enumerate(envs)])
@@ -116,8 +118,8 @@ def envs_alone(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     from functools import partial
 
     from gymfg_il.envs.flight import FlightSpec
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.vec import groups_of
+    from gymfg_il.rl.envs import make_env
+    from gymfg_il.rl.grouped.vec import groups_of
 
     flight = FlightSpec.solo("c172p", "altitude")
     env_fn = partial(make_env, flight.to_dict(), [0.0] * 4, [1.0] * 4, 0.2)
@@ -148,7 +150,7 @@ def envs_alone(n_envs: int) -> tuple[Callable[[int], None], Callable[[], None]]:
     return step, close
 
 
-def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> list[Row]:
+def sampling_vs_bound(n_envs: int, steps: int, rounds: int, kind: str = "grouped") -> list[Row]:
     """Rounds of three, the order turning: PPO sampling with ``n_envs`` envs, the same envs
     with no policy (``envs_alone``), and one bare JSBSim loop (times min(n_envs, cores): the
     bound with every core on physics). Two rows: the sampling and the envs alone, over the
@@ -160,7 +162,7 @@ def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> list[Row]:
     cores = len(os.sched_getaffinity(0))
     threads = torch.get_num_threads()
     torch.set_num_threads(1)  # as train ppo runs it
-    collect, close = sampler(n_envs)
+    collect, close = sampler(n_envs, kind)
     alone, close_alone = envs_alone(n_envs)
     raw = raw_loop()
     collect(steps // 4)  # the workers warm
@@ -183,9 +185,10 @@ def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> list[Row]:
         close_alone()
         torch.set_num_threads(threads)
     own = "" if n_envs == cores else f"_{n_envs}_envs"  # the row by its name: envs = cores
+    own += "" if kind == "grouped" else f"_{kind}"
     bound = statistics.median(rates[raw]) * min(n_envs, cores)
     detail = [
-        f"PPO sampling, {n_envs} envs            {statistics.median(rates[collect]):9,.0f} steps/s",
+        f"PPO sampling ({kind}), {n_envs} envs  {statistics.median(rates[collect]):9,.0f} steps/s",
         f"the envs alone, no policy   {statistics.median(rates[alone]):9,.0f} steps/s",
         f"bound: {min(n_envs, cores)} x bare JSBSim      {bound:9,.0f} steps/s",
     ]
@@ -208,19 +211,22 @@ def sampling_vs_bound(n_envs: int, steps: int, rounds: int) -> list[Row]:
     ]
 
 
-def rows(quick: bool, envs: tuple[int, ...] | None = None) -> list[Row]:
+def rows(quick: bool, envs: tuple[int, ...] | None = None, kind: str = "grouped") -> list[Row]:
     cores = len(os.sched_getaffinity(0))
     chosen = envs or ((cores,) if quick else (cores, 4 * cores))
     steps, rounds = (1024, 3) if quick else (8192, 6)
-    return [row for n in chosen for row in sampling_vs_bound(n, steps, rounds)]
+    return [row for n in chosen for row in sampling_vs_bound(n, steps, rounds, kind)]
 
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     p.add_argument("--envs", type=int, nargs="+", help="env counts (default: cores, 4 x cores)")
     p.add_argument("--quick", action="store_true")
+    p.add_argument(
+        "--sampler", choices=("grouped", "sb3"), default="grouped", help="train ppo's --sampler"
+    )
     args = p.parse_args(argv)
-    print_rows(rows(args.quick, tuple(args.envs) if args.envs else None))
+    print_rows(rows(args.quick, tuple(args.envs) if args.envs else None, args.sampler))
     return 0
 
 

@@ -12,7 +12,11 @@ import dataclasses
 import sys
 import typing
 from importlib.util import find_spec
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from gymfg_il.envs.flight import FlightSpec
+    from gymfg_il.rl.config import PPORunConfig
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -47,22 +51,40 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _ppo_parser(sub: Any) -> None:
+    """``ppo``'s flags in groups: the run, the flight, the evaluations, PPO's own (their
+    defaults per task from ``rl/hyperparams.toml``)."""
     from gymfg_il import cli
+    from gymfg_il.envs.options import TASK_OWN_TIME, FlightOptions, unset_values
+    from gymfg_il.rl import hyperparams
     from gymfg_il.rl.config import PPORunConfig
 
     ppo = sub.add_parser(
         "ppo",
         help="fine-tune a cloned MLP policy by RL (PPO, stable-baselines3), or train from scratch",
         description="Fine-tune a cloned MLP policy with PPO (stable-baselines3) in its own "
-        "flight, in the weather the flags give: the actor starts as the policy, the critic "
-        "is warmed up first, and a decaying anchor keeps the first updates near the start. "
+        "flight, or learn one from scratch: the actor starts as the policy, the critic is "
+        "warmed up first, and a decaying anchor keeps the first updates near the start. "
         "Evaluates on held-out seeds every --eval-every steps (the start and the controller "
         "too) and saves a ppo policy (config.json, model.safetensors) that eval, collect "
         "dagger and --assist fly, with curve.png, curve.json and a TensorBoard log. Needs the "
         "rl extra: pip install -e '.[rl]'.",
     )
-    cli.add_fields(ppo, PPORunConfig)
+    run = ("init", "steps", "out", "envs", "seed", "sampler", "device", "hidden")
+    cli.add_fields(ppo, PPORunConfig, only=run)
     ppo.add_argument("--no-progress", action="store_true", help="no progress bar")
+    flight = ppo.add_argument_group("the flight (with --init, left out: the policy's own)")
+    unset = {**unset_values(), "episode_time_s": TASK_OWN_TIME}
+    options = tuple(f.name for f in dataclasses.fields(FlightOptions))
+    shown = {k: f"the policy's; from scratch {v}" for k, v in unset.items()}
+    shown |= dict.fromkeys(("task", "aircraft"), "the policy's; from scratch, give it")
+    cli.add_fields(typing.cast(Any, flight), PPORunConfig, only=options, shown=shown)
+    evaluation = ppo.add_argument_group("evaluations")
+    judged = ("eval_every", "eval_episodes", "eval_seed", "select_episodes", "keep", "checkpoints")
+    cli.add_fields(typing.cast(Any, evaluation), PPORunConfig, only=judged)
+    own = ppo.add_argument_group("PPO's own (defaults per task: gymfg_il/rl/hyperparams.toml)")
+    table = hyperparams.table(None)
+    shown = {k: f"{v}, or the task's in hyperparams.toml" for k, v in table.items()}
+    cli.add_fields(typing.cast(Any, own), PPORunConfig, only=hyperparams.NAMES, shown=shown)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -95,18 +117,7 @@ def _ppo(args: argparse.Namespace) -> int:
     start = starting_policy(cfg)
     for note in start.notes:
         print(note, file=sys.stderr)
-    flight = start.flight
-    kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
-    keep = f"the kept actor the best on {kept_on}" if cfg.keep == "best" else "the last kept"
-    if cfg.average_start is not None:
-        keep = f"the kept actor the mean of those from step {cfg.average_start:,} on ({kept_on})"
-    print(
-        f"PPO on {flight.task_label} on {flight.aircraft} ({flight.turbulence} turbulence): "
-        f"{cfg.steps:,} env steps on {cfg.n_envs} env(s), evaluated every {cfg.eval_every:,} "
-        f"on seeds {cfg.eval_seed}..{cfg.eval_seed + cfg.eval_episodes - 1} (the curve), "
-        f"{keep}",
-        file=sys.stderr,
-    )
+    print(ppo_plan(cfg, start.flight), file=sys.stderr)
     bar = cli.progress_bar(cfg.steps, "env steps", "step", not args.no_progress)
 
     def on_eval(point: Any) -> None:
@@ -125,18 +136,35 @@ def _ppo(args: argparse.Namespace) -> int:
         f"{100 * expert.success:.0f}%), return {first.mean_return:.1f} -> "
         f"{last.mean_return:.1f} (controller {expert.mean_return:.1f})"
     )
-    kept, averaged = result.kept, result.averaged
-    if averaged:
-        which = f"the mean of the {len(averaged)} actors of steps {averaged[0]:,}..{averaged[-1]:,}"
-    else:
-        which = "the actor of " + ("the start" if kept.step == 0 else f"step {kept.step:,}")
-        if cfg.keep == "average":  # the start flew better than the average
-            which += " (the average flew worse on these seeds)"
+    kept = result.kept
+    which = "the actor of " + ("the start" if kept.step == 0 else f"step {kept.step:,}")
     print(
         f"policy saved to {result.out}: {which} ({100 * kept.select_success:.0f}% success on "
         f"{kept.chosen_on} evaluation seeds; curve: {result.out / 'curve.png'})"
     )
     return 0
+
+
+def ppo_plan(cfg: PPORunConfig, flight: FlightSpec) -> str:
+    """What a ``train ppo`` run will do, in a line: the flight and its air, the steps and
+    envs, how many of them the actor learns from, the evaluations and the kept actor."""
+    air = "still air" if flight.turbulence == "none" else f"{flight.turbulence} turbulence"
+    if flight.wind_kt:
+        air += f" and a {flight.wind_kt:g} kt wind"
+    last = cfg.eval_seed + cfg.eval_episodes - 1
+    when = f"every {cfg.eval_every:,} env steps" if cfg.eval_every < cfg.steps else "at the start"
+    kept_on = f"{cfg.eval_seed}..{cfg.eval_seed + cfg.chosen_on - 1}"
+    sampled = -(-cfg.steps // cfg.rollout) * cfg.rollout  # whole rollouts
+    keep = "the last actor kept"
+    if cfg.keep == "best":
+        keep = f"the kept actor the best on seeds {kept_on}"
+    return (
+        f"PPO on {flight.task_label} on {flight.aircraft} in {air}: {cfg.steps:,} env steps on "
+        f"{cfg.n_envs} env(s); the critic alone learns from the first "
+        f"{sampled - cfg.actor_steps:,}, the actor too from the next {cfg.actor_steps:,}; "
+        f"evaluated {when} and at the end on "
+        f"seeds {cfg.eval_seed}..{last} (the curve), {keep}"
+    )
 
 
 def _bc(args: argparse.Namespace) -> int:

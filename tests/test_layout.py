@@ -91,6 +91,10 @@ def test_the_old_paths_are_the_ones_users_were_told_about():
     assert old_paths() == {
         "gymfg_il.controllers.agent",
         "gymfg_il.manual.cockpit",
+        "gymfg_il.rl.env",
+        "gymfg_il.rl.forward",
+        "gymfg_il.rl.sampling",
+        "gymfg_il.rl.vec",
         "gymfg_il.viz.flightgear",
         "gymfg_il.viz.multiplayer",
         "gymfg_il.viz.netfdm",

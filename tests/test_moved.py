@@ -14,6 +14,10 @@ MOVED = {  # old module -> (new module, a name users import from it)
     "gymfg_il.viz.peers": ("gymfg_il.flightgear.peers", "MultiplayerConfig"),
     "gymfg_il.viz.multiplayer": ("gymfg_il.flightgear.multiplayer", "TrafficSender"),
     "gymfg_il.manual.cockpit": ("gymfg_il.flightgear.cockpit", "CockpitReceiver"),
+    "gymfg_il.rl.env": ("gymfg_il.rl.envs", "make_env"),
+    "gymfg_il.rl.vec": ("gymfg_il.rl.grouped.vec", "GroupedVecEnv"),
+    "gymfg_il.rl.forward": ("gymfg_il.rl.grouped.forward", "NumpyActorCritic"),
+    "gymfg_il.rl.sampling": ("gymfg_il.rl.grouped.sampling", "sample_rollout"),
 }
 
 

@@ -12,8 +12,8 @@ first 16 seeds) and its choice figure (curve.json), then both fresh figures; bel
 held-out success of the actor each rule keeps: the best on the curve's 16 seeds, on the run's
 select_episodes seeds (``train ppo``'s choice), on the CHECK seeds, the best held out (the
 ceiling no rule can pass), and the mean of the weights of the actors from --average-from of
-the run on (``train ppo --keep average``'s actor, flown the same way). The results:
-docs/results/rl.md.
+the run on (what ``train ppo --keep average`` kept, an option since removed, flown the same
+way). The results: docs/experiments/rl-sessions.md (tenth and eleventh sessions).
 """
 
 from __future__ import annotations
@@ -23,22 +23,34 @@ import json
 import shutil
 import tempfile
 from pathlib import Path
+from typing import Any
 
+import torch
 from safetensors.torch import load_file, save_file
 
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.evaluation.metrics import score_episode
 from gymfg_il.evaluation.runner import evaluate
-from gymfg_il.rl.judge import mean_weights
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.workers import Workers
 
 BLOCKS = (9300, 9400, 9500)
 
 
+def mean_weights(parts: list[dict[str, Any]]) -> dict[str, Any]:
+    """The mean of several state dicts of one network (torch tensors), in float64 and cast
+    back, so that what is the same in all (the normalisations) stays exactly as it is."""
+    return {
+        k: torch.stack([w[k].double() for w in parts]).mean(0).to(v.dtype)
+        if v.is_floating_point()
+        else v
+        for k, v in parts[-1].items()
+    }
+
+
 def averaged(run: Path, steps: list[int], folder: Path) -> Path:
     """A policy in ``folder`` whose weights are the mean of the checkpoints of ``steps``, as
-    ``train ppo --keep average`` computes it (``rl.judge.mean_weights``)."""
+    ``train ppo --keep average`` computed it before it was removed (``mean_weights``)."""
     parts = [load_file(str(run / "checkpoints" / f"step-{s}" / "model.safetensors")) for s in steps]
     folder.mkdir(parents=True)
     shutil.copy(run / "checkpoints" / f"step-{steps[-1]}" / "config.json", folder / "config.json")

@@ -1,13 +1,14 @@
 """One env process's share of ``train ppo``'s sampling, in this process: ``N`` c172p altitude
-envs (10 Hz) sampled by the numpy policy (``rl.sampling.sample_rollout``, a fresh MLP), beside
-a bare JSBSim loop of the same agent steps (``benchmarks.physics.raw_loop``), three rounds;
-with ``--profile``, cProfile's top functions of one more rollout; with ``--parts``, the time
-of each part of the loop's step (the actor's pass, the clip, the envs' steps, the rest),
-measured inside the loop, and the same loop with a fixed action in place of the actor.
+envs (10 Hz) sampled by the numpy policy (``rl.grouped.sampling.sample_rollout``, a fresh
+MLP), beside a bare JSBSim loop of the same agent steps (``benchmarks.physics.raw_loop``),
+three rounds; with ``--profile``, cProfile's top functions of one more rollout; with
+``--parts``, the time of each part of the loop's step (the actor's pass, the clip, the envs'
+steps, the rest), measured inside the loop, and the same loop with a fixed action in place of
+the actor.
 
     PYTHONPATH=. python docs/experiments/rl_sampling_profile.py [--envs 4] [--profile] [--parts]
 
-The results: docs/results/rl.md, Speed.
+The results: docs/experiments/rl-sessions.md, Speed.
 """
 
 from __future__ import annotations
@@ -29,9 +30,9 @@ from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.policies.modeling_mlp import MLPPolicy
 from gymfg_il.rl.config import PPORunConfig
-from gymfg_il.rl.env import make_env
-from gymfg_il.rl.run import make_model
-from gymfg_il.rl.sampling import install, sample_rollout, sampling_copy, step_env
+from gymfg_il.rl.envs import make_env
+from gymfg_il.rl.grouped.sampling import install, sample_rollout, sampling_copy, step_env
+from gymfg_il.rl.model import make_model
 
 STEPS = 2000  # steps of each env a round
 

@@ -1,16 +1,22 @@
-"""The settings of a PPO fine-tuning run (``PPORunConfig``, ``train ppo``)."""
+"""The settings of a PPO run (``PPORunConfig``, ``train ppo``): the flight options
+(``envs.options.FlightOptions``), what to start from and how long to train, the envs, the
+evaluations, and PPO's own settings (``hyperparams.toml`` per task, ``rl.hyperparams``)."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
+from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.options import FlightOptions
 from gymfg_il.errors import ConfigError, join_problems
+from gymfg_il.rl import hyperparams
 from gymfg_il.rl.folders import overlap_problem
-from gymfg_il.sim.weather import Turbulence
+from gymfg_il.rl.hyperparams import PPOSettings
 from gymfg_il.typecheck import SEED_LIMIT, SEED_RULE, seed_problem, type_problems
 
 ANCHOR_SPAN_MAX = 150_000  # the longest the anchor decays over by default (``anchor_steps``)
@@ -20,226 +26,171 @@ FINE_TUNE_ACTOR_LR = 1e-4
 SELECT_EPISODES = 64
 # the default discount and GAE lambda per step at DISCOUNT_HZ, kept per second at other rates
 DEFAULT_GAMMA, DEFAULT_GAE_LAMBDA, DISCOUNT_HZ = 0.99, 0.95, 10
+WARMUP_MAX = 20_000  # the longest the critic warms up by default (``critic_warmup``)
 
 
 @dataclass
-class PPORunConfig:
-    """PPO fine-tuning of a cloned MLP policy (stable-baselines3), or PPO from scratch.
+class PPORunConfig(FlightOptions):
+    """PPO (stable-baselines3) on a solo flight: fine-tuning a cloned MLP policy, or learning
+    from scratch. With --init the run flies the policy's own flight (its task, aircraft and
+    rate, which may not change), with the flight options that are given in place of its own
+    (each change is printed); from scratch the options name the flight (--task and
+    --aircraft at least).
 
     Attributes:
-        init: the MLP policy to start from (a folder ``train bc --policy mlp`` wrote): the
-            actor starts as its network and normalisation and flies its task and aircraft;
-            left out, PPO learns from scratch (give --task and --aircraft), the comparison.
-        steps: environment steps to train for (all envs together).
+        init: the MLP policy to start from (a folder ``train bc --policy mlp`` or ``train
+            ppo`` wrote): the actor starts as its network and normalisation; left out, PPO
+            learns from scratch (give --task and --aircraft).
+        steps: environment steps to train for (all envs together); the actor learns after
+            the critic's warm-up (--critic-warmup), so a run must be longer than that.
         out: where the policy goes (default: policies/ppo-<task>-<aircraft>).
-        task: the task, from scratch; with --init it must be the policy's own.
-        aircraft: the aircraft, from scratch; with --init it must be the policy's own.
-        agent_hz: the agent rate (Hz), from scratch (default: 10; with --init: the policy's
-            own, and another is refused).
-        turbulence: the air to train in: none, light, moderate or severe (default: the
-            starting policy's; a change is printed as a note).
-        wind_kt: a steady wind (knots) to train in (default: the starting policy's).
-        envs: environments sampled in parallel, in one process per CPU core (0: four per
-            core; ``benchmarks.rl`` measures the sampling rate).
-        seed: seeds the envs (env k starts from seed + k), the sampling and the networks; a
-            run with the same settings and the same number of envs repeats exactly on the
-            same machine and install (give --envs to repeat a run on a machine with other
-            cores; on another machine a long run may part from it, docs/results/rl.md). Env
-            k draws all its episodes from seed + k, so runs meant to be independent take
-            seeds at least envs apart (seeds 3 and 4 share 7 of 8 envs' episodes).
-        eval_every: evaluate the policy's mean action every this many env steps.
+        envs: environments sampled in parallel (0: four per CPU core).
+        seed: seeds the envs (env k draws all its episodes from seed + k), the sampling and
+            the networks: the same settings and number of envs repeat a run exactly on the
+            same machine and install. Runs meant to be independent take seeds at least envs
+            apart, or they share most of their episodes.
+        sampler: how rollouts are sampled: ``grouped``, in the env processes, one per core,
+            each sampling its envs' actions from a copy of the policy (``rl.grouped``), or
+            ``sb3``, stable-baselines3's own loop (one process per env, the policy run in
+            the trainer between steps). Both sample the same policy; their noise comes from
+            different generators, so a seed flies another run on each.
+        device: cpu or cuda (the networks are small: cpu is usually faster).
+        hidden: hidden widths of the actor, from scratch (with --init: the policy's own).
+        eval_every: evaluate the policy's mean action every this many env steps (and at the
+            start and the end).
         eval_episodes: held-out episodes each evaluation flies (seeds eval_seed, eval_seed +
-            1, ...), the same every time, with the controller on them once.
+            1, ...), the same every time, with the controller on them once: the curve.
         eval_seed: the first held-out seed.
-        select_episodes: episodes each evaluation flies to choose the kept actor (with
-            --keep best; with --keep average the start and the average fly them, the other
-            evaluations the curve's alone): the curve's eval_episodes seeds and the next
-            ones (seeds eval_seed .. eval_seed + select_episodes - 1), on two processes
-            (default: 64, or eval_episodes if more). On 16 episodes a success rate spreads
-            about 10 points, as much as the actors differ, and the best of twenty such draws
-            is mostly the luckiest (docs/results/rl.md). Equal to eval_episodes: chosen on
-            the curve's seeds alone.
+        select_episodes: episodes each evaluation flies to choose the kept actor (with --keep
+            best): the curve's seeds and the next ones (eval_seed .. eval_seed +
+            select_episodes - 1), on two processes (default: 64, or eval_episodes if more).
         keep: which actor is saved: ``best``, the evaluation with the highest success (then
             return) on the select_episodes seeds, the start included, so the result never
-            flies worse than the start on these seeds; ``average``, the mean of the weights
-            of the actors evaluated from average_from of the run on (the last one included),
-            flown on the select_episodes seeds and kept unless it flies worse there than
-            the start (by success, then return; then the start is kept); or ``last``, the
-            actor as training left it.
-            Judge the result on other seeds (``eval --seed``).
-        average_from: with --keep average, the share of the run from which the evaluated
-            actors are averaged (0.5: those of its second half).
+            flies worse than the start on these seeds; or ``last``, the actor as training
+            left it. Judge the result on other seeds (``eval --seed``).
         checkpoints: keep every evaluated actor, a policy in OUT/checkpoints/step-N (about
-            0.6 MB each; with --keep average the mean too, in OUT/checkpoints/average), to
-            fly again (``eval --policy``) or choose on other seeds.
+            0.6 MB each), to fly again (``eval --policy``).
         rollout_steps: steps each env samples between updates (PPO's n_steps).
         batch_size: samples per gradient step, a divisor of the rollout (rollout_steps x envs).
         epochs: passes over each rollout per update.
         lr: Adam learning rate of the critic.
-        actor_lr: Adam learning rate of the actor (default: 1e-4 when fine-tuning, whatever
-            --lr is, a third of the default critic's, so that the cloned actor moves slower
-            than the critic learns and runs do not fall below their start,
-            docs/results/rl.md; from scratch: lr).
+        actor_lr: Adam learning rate of the actor (default: 1e-4 when fine-tuning, so that the
+            cloned actor moves slower than the critic learns; from scratch: lr).
         gamma: discount per step (default: 0.99 at 10 Hz, and at other agent rates the same
-            decay per second, 0.99 ** (10 / Hz): 0.9967 at 30 Hz; at 30 Hz a plain 0.99 sees
-            3 s ahead, and a fine-tuned turn learnt to crash; docs/results/rl.md).
+            decay per second, 0.99 ** (10 / Hz)).
         gae_lambda: GAE's lambda per step (default: 0.95 at 10 Hz, likewise per second).
         clip_range: PPO's clip on the probability ratio.
         target_kl: an update stops early when its KL divergence from the sampling policy
             passes 1.5 x this (0: never).
-        exploration: how PPO explores: ``sde`` (default; stable-baselines3's generalised
-            state-dependent exploration: the noise is a linear map of the normalised
-            observation, drawn anew every sde_every steps, so the controls deviate coherently
-            for a while, which a slow aircraft's state answers) or ``gaussian`` (a new noise
-            every step).
-        sde_every: steps between new gSDE noise maps (0: one per rollout).
         action_std: the exploration noise's starting spread in the policy's normalised action
-            units (1 = the demonstrations' spread of each control).
-        action_floor: the least spread of each control (aileron, elevator, rudder, throttle;
-            raw units) in the units PPO explores and steps the actor in, which are the
-            demonstrations' spread of each control (``--action-std``): a control the
-            demonstrations hardly moved (the throttle in still air) is otherwise explored
-            and changed by that little. The starting policy flies as before (its last layer
-            is rescaled to match); default: the demonstrations' spread as it is (why:
-            docs/results/rl.md).
-        critic_warmup: env steps over which only the critic learns, the actor held, so the
-            first actor updates follow a trained value function: every update on a rollout
-            that began before this many steps (default: a tenth of the run, at most 20,000
-            steps; at least one rollout).
+            units (1 = the demonstrations' spread of each control). PPO explores with
+            stable-baselines3's generalised state-dependent exploration (gSDE): the noise is
+            a linear map of the normalised observation, drawn anew every rollout, so the
+            controls deviate coherently for a while.
+        critic_warmup: env steps over which only the critic learns, the actor held, so that
+            the first actor updates follow a trained value function: every update on a
+            rollout that began before this many steps (default: a tenth of the run, at most
+            20,000 steps, at least one rollout); then the actor's rate ramps up from 0 over
+            as many steps when fine-tuning.
         success_bonus: at the end of each training episode, the task judges it as eval does,
             and a success adds this share of the episode's steps to its return (a step's task
-            reward is at most about 1), so what PPO maximises includes what success measures
-            (0: the task's reward alone).
-        clock: the critic sees the share of the episode flown, and the time limit ends an
-            episode's return instead of being bootstrapped past: the task is judged over its
-            last seconds and the bonus comes at the limit, so what a state is worth depends
-            on the time left (``rl.env.EpisodeClock``). The actor never sees it. Off by
-            default (why: docs/results/rl.md).
-        stall_margin_kt: each training step flown slower than the aircraft's stall speed
-            (where the task ends an episode) plus this many knots costs a step's whole task
-            reward (1): a stall otherwise costs only the reward after it, a few steps' worth
-            at PPO's discount (0: no cost; docs/results/rl.md).
-        bank_limit_deg: each training step banked beyond this many degrees either way costs
-            a step's whole task reward (1): a turn fine-tuned without it banked hard, lost
-            the altitude in its first seconds and chattered about the new heading (0: no
-            cost; the c172p's maneuvers bank 25 degrees; docs/results/rl.md).
+            reward is at most about 1; 0: the task's reward alone; ``rl.reward``).
         anchor: weight, at the start, of the squared distance between the actor's mean action
             and the starting policy's (normalised units) added to PPO's loss; it decays
             linearly to 0 over anchor_steps (0: no anchor). Not used from scratch.
         anchor_steps: env steps over which the anchor decays (default: half the run, at most
-            150k: a longer anchor holds a long run at its start; docs/results/rl.md).
+            150,000).
         critic: hidden widths of the critic (value network).
-        hidden: hidden widths of the actor, from scratch (with --init: the policy's own).
-        device: cpu or cuda (the networks are small: cpu is usually faster).
     """
 
     init: Path | None = None
     steps: int = 1_000_000
     out: Path | None = None
-    task: str | None = None
-    aircraft: str | None = None
-    agent_hz: int | None = None
-    turbulence: Turbulence | None = None
-    wind_kt: float | None = None
     envs: int = 0
     seed: int = 0
+    sampler: Literal["grouped", "sb3"] = "grouped"
+    device: str = "cpu"
+    hidden: list[int] = field(default_factory=lambda: [256, 256])
     eval_every: int = 50_000
     eval_episodes: int = 16
     eval_seed: int = 7000
     select_episodes: int | None = None
-    keep: Literal["best", "last", "average"] = "best"
-    average_from: float = 0.5
+    keep: Literal["best", "last"] = "best"
     checkpoints: bool = False
-    rollout_steps: int = 512
-    batch_size: int = 512
-    epochs: int = 10
-    lr: float = 3e-4
+    # PPO's own: None takes the task's value in hyperparams.toml (``ppo``)
+    rollout_steps: int | None = None
+    batch_size: int | None = None
+    epochs: int | None = None
+    lr: float | None = None
     actor_lr: float | None = None
     gamma: float | None = None
     gae_lambda: float | None = None
-    clip_range: float = 0.2
-    target_kl: float = 0.02
-    exploration: Literal["sde", "gaussian"] = "sde"
-    sde_every: int = 0
-    action_std: float = 0.2
-    action_floor: tuple[float, float, float, float] | None = None
+    clip_range: float | None = None
+    target_kl: float | None = None
+    action_std: float | None = None
     critic_warmup: int | None = None
-    success_bonus: float = 0.2
-    clock: bool = False
-    stall_margin_kt: float = 0.0
-    bank_limit_deg: float = 0.0
-    anchor: float = 1.0
+    success_bonus: float | None = None
+    anchor: float | None = None
     anchor_steps: int | None = None
-    critic: list[int] = field(default_factory=lambda: [256, 256])
-    hidden: list[int] = field(default_factory=lambda: [256, 256])
-    device: str = "cpu"
+    critic: list[int] | None = None
 
     def __post_init__(self) -> None:
         typed = type_problems(self)
         if typed:
             raise ConfigError(join_problems("train ppo", typed))
+        self.init = None if self.init is None else Path(self.init)
+        given = {n: getattr(self, n) for n in hyperparams.NAMES if getattr(self, n) is not None}
+        self._ppo = hyperparams.resolve(self.ppo_task, given)
+        problems = self._run_problems() + self.ppo.problems()
+        if self.envs >= 0:
+            problems += self._seed_problems()
+        if not problems:  # the counts a rollout is made of are sound
+            problems += self._rollout_problems()
+        if problems:
+            raise ConfigError(join_problems("train ppo", problems))
+
+    @property
+    def ppo(self) -> PPOSettings:
+        """PPO's settings for this run: those given, else the task's in hyperparams.toml."""
+        return self._ppo
+
+    @property
+    def ppo_task(self) -> str | None:
+        """The task whose PPO settings the run takes: ``task``, else the starting policy's
+        (from its config.json; None where that cannot be read, and the start says why)."""
+        if self.task is not None or self.init is None:
+            return self.task
+        try:
+            spec = json.loads((self.init / "config.json").read_text())["spec"]
+            return FlightSpec.from_dict(spec).task
+        except (OSError, ValueError, KeyError, TypeError, AttributeError, ConfigError):
+            return None
+
+    def _run_problems(self) -> list[str]:
+        """What is wrong with the run's own settings (not PPO's)."""
         problems = []
         if self.init is None and (self.task is None or self.aircraft is None):
             problems.append(
                 "give --init POLICY (a cloned MLP to fine-tune) or, from scratch, --task and "
                 "--aircraft"
             )
-        positive = ("steps", "eval_every", "eval_episodes", "rollout_steps", "epochs")
-        for name in positive:
+        if self.episode_time_s is not None and not self.episode_time_s > 0:
+            problems.append(f"episode_time_s={self.episode_time_s} must be > 0")
+        for name in ("steps", "eval_every", "eval_episodes"):
             if getattr(self, name) < 1:
                 problems.append(f"{name}={getattr(self, name)} must be >= 1")
+        if self.envs < 0:
+            problems.append(f"envs={self.envs}: want 0 (four per core) or more")
         if self.select_episodes is not None and self.select_episodes < self.eval_episodes:
             problems.append(
                 f"select_episodes={self.select_episodes} must be >= eval_episodes="
                 f"{self.eval_episodes} (the kept actor is chosen on the curve's seeds and more)"
             )
-        problems += self._rollout_problems() + self._seed_problems()
         problems += filter(None, [overlap_problem(self.init, self.out)])
-        if self.sde_every < 0:
-            problems.append(f"sde_every={self.sde_every}: want 0 (once a rollout) or more")
-        problems += self._rate_problems()
-        if not 0 <= self.average_from < 1:
-            problems.append(
-                f"average_from={self.average_from} must lie in [0, 1) (a share of the run)"
-            )
-        if not 0 < self.clip_range < 1:
-            problems.append(f"clip_range={self.clip_range} must lie in (0, 1)")
-        if not 0 <= self.bank_limit_deg < 180:
-            problems.append(f"bank_limit_deg={self.bank_limit_deg}: want 0 (off) up to 180")
-        for name in ("target_kl", "anchor", "success_bonus", "stall_margin_kt"):
-            value = getattr(self, name)
-            if not (value >= 0 and math.isfinite(value)):
-                problems.append(f"{name}={value} must be a number >= 0")
-        if not (0 < self.action_std <= 10):
-            problems.append(f"action_std={self.action_std} must lie in (0, 10]")
-        if self.action_floor is not None and not all(0 <= v <= 1 for v in self.action_floor):
-            problems.append(
-                f"action_floor={self.action_floor}: want four spreads in [0, 1] (raw units of "
-                "aileron, elevator, rudder, throttle)"
-            )
-        for name in ("critic_warmup", "anchor_steps"):
-            value = getattr(self, name)
-            if value is not None and value < 0:
-                problems.append(f"{name}={value} must be >= 0 env steps")
-        if not self.critic or min(self.critic) < 1 or not self.hidden or min(self.hidden) < 1:
-            problems.append("critic and hidden must be non-empty lists of widths > 0")
+        if not self.hidden or min(self.hidden) < 1:
+            problems.append(f"hidden={self.hidden}: want a non-empty list of widths > 0")
         if self.device not in ("cpu", "cuda", "auto") and not self.device.startswith("cuda:"):
             problems.append(f"device={self.device!r}: use cpu, cuda, cuda:N or auto")
-        if problems:
-            raise ConfigError(join_problems("train ppo", problems))
-        self.init = None if self.init is None else Path(self.init)
-
-    def _rate_problems(self) -> list[str]:
-        """The learning rates and the discounts out of their ranges."""
-        problems = []
-        if not 0 < self.lr < 1:
-            problems.append(f"lr={self.lr} must lie in (0, 1) (default 3e-4)")
-        if self.actor_lr is not None and not 0 < self.actor_lr < 1:
-            problems.append(f"actor_lr={self.actor_lr} must lie in (0, 1)")
-        for name in ("gamma", "gae_lambda"):
-            value = getattr(self, name)
-            if value is not None and not 0 < value <= 1:
-                problems.append(f"{name}={value} must lie in (0, 1]")
         return problems
 
     def _seed_problems(self) -> list[str]:
@@ -250,7 +201,7 @@ class PPORunConfig:
         problems = []
         if problem := seed_problem(self.seed):
             problems.append(problem)
-        elif self.envs >= 0 and (last := self.seed + self.n_envs - 1) >= SEED_LIMIT:
+        elif (last := self.seed + self.n_envs - 1) >= SEED_LIMIT:
             problems.append(
                 f"seed={self.seed}: env {last - self.seed} starts from seed {last}, and a seed "
                 f"is an integer {SEED_RULE}; give --seed {SEED_LIMIT - self.n_envs} or below"
@@ -261,33 +212,32 @@ class PPORunConfig:
 
     def _rollout_problems(self) -> list[str]:
         """What stable-baselines3's PPO would stop on (an assertion, after the start's
-        evaluation had flown) or warn of: PPO normalises the advantages of each batch, so a
-        batch holds 2 samples or more, a rollout (rollout_steps x envs) too, and the batches
-        divide the rollout (else each epoch ends on a truncated batch)."""
-        problems = []
-        if self.envs < 0:
-            problems.append(f"envs={self.envs}: want 0 (four per core) or more")
-        if self.batch_size < 2:
-            problems.append(
-                f"batch_size={self.batch_size} must be >= 2 (PPO normalises each batch's "
-                "advantages)"
-            )
-        if problems or self.rollout_steps < 1:  # rollout_steps: refused with the other counts
-            return problems
+        evaluation had flown) or warn of, and a run whose actor would never learn: PPO
+        normalises the advantages of each batch, so a rollout (rollout_steps x envs) holds 2
+        samples or more, and the batches divide it (else each epoch ends on a truncated
+        batch); the actor learns only after the critic's warm-up."""
         envs = f"envs={self.envs}" if self.envs else f"{self.n_envs} envs (four a core)"
-        rollout = self.rollout
+        rollout, batch = self.rollout, self.ppo.batch_size
         if rollout < 2:
             return [
-                f"rollout_steps={self.rollout_steps} x {envs} is a rollout of {rollout} sample; "
-                "PPO normalises a rollout's advantages, which takes 2 or more: give "
+                f"rollout_steps={self.ppo.rollout_steps} x {envs} is a rollout of {rollout} "
+                "sample; PPO normalises a rollout's advantages, which takes 2 or more: give "
                 "--rollout-steps 2 or more, or --envs 2 or more"
             ]
-        if rollout % self.batch_size:
-            fits = batch_that_fits(rollout, self.batch_size)
+        if rollout % batch:
             return [
-                f"batch_size={self.batch_size} must divide a rollout's {rollout} samples "
-                f"(rollout_steps={self.rollout_steps} x {envs}), or each epoch ends on a "
-                f"truncated batch: give --batch-size {fits}, or a rollout it divides"
+                f"batch_size={batch} must divide a rollout's {rollout} samples "
+                f"(rollout_steps={self.ppo.rollout_steps} x {envs}), or each epoch ends on a "
+                f"truncated batch: give --batch-size {batch_that_fits(rollout, batch)}, or a "
+                "rollout it divides"
+            ]
+        if self.actor_steps == 0:
+            return [
+                f"steps={self.steps:,}: the actor would never learn: the critic warms up over "
+                f"the first {self.warmup_steps:,} env steps (--critic-warmup; a rollout is "
+                f"{rollout:,}: rollout_steps={self.ppo.rollout_steps} x {envs}) and the run "
+                f"ends there; give --steps {self.least_steps():,} or more, or a shorter "
+                "--critic-warmup"
             ]
         return []
 
@@ -307,41 +257,62 @@ class PPORunConfig:
         return max(SELECT_EPISODES, self.eval_episodes)
 
     @property
-    def average_start(self) -> int | None:
-        """With keep ``average``: the env step from which evaluated actors are averaged."""
-        return int(self.steps * self.average_from) if self.keep == "average" else None
-
-    @property
     def rollout(self) -> int:
         """Env steps per update, all envs together."""
-        return self.rollout_steps * self.n_envs
+        return self.ppo.rollout_steps * self.n_envs
 
     @property
     def actor_rate(self) -> float:
         """The actor's learning rate: ``actor_lr``, else 1e-4 when fine-tuning, else ``lr``."""
-        if self.actor_lr is not None:
-            return self.actor_lr
-        return FINE_TUNE_ACTOR_LR if self.init is not None else self.lr
+        if self.ppo.actor_lr is not None:
+            return self.ppo.actor_lr
+        return FINE_TUNE_ACTOR_LR if self.init is not None else self.ppo.lr
 
     @property
     def warmup_steps(self) -> int:
-        if self.critic_warmup is not None:
-            return self.critic_warmup
-        return max(self.rollout, min(20_000, self.steps // 10))
+        """The env steps over which only the critic learns."""
+        return self._warmup(self.steps)
+
+    def _warmup(self, steps: int) -> int:
+        if self.ppo.critic_warmup is not None:
+            return self.ppo.critic_warmup
+        return max(self.rollout, min(WARMUP_MAX, steps // 10))
+
+    @property
+    def actor_steps(self) -> int:
+        """The env steps of the rollouts the actor learns from: every update's rollout after
+        the warm-up (a run samples whole rollouts, ``steps`` or more)."""
+        return _actor_steps(self.steps, self.rollout, self.warmup_steps)
+
+    def least_steps(self) -> int:
+        """The fewest ``steps`` whose run has the actor learn from one rollout."""
+        rollout, k = self.rollout, 1
+        while _actor_steps(k * rollout, rollout, self._warmup(k * rollout)) == 0:
+            k += 1
+        return k * rollout
 
     def discounts(self, agent_hz: int) -> tuple[float, float]:
         """(gamma, GAE lambda) for a flight at ``agent_hz``: as given, else the decay per
         second of 0.99 and 0.95 a step at ``DISCOUNT_HZ``."""
         k = DISCOUNT_HZ / agent_hz
-        gamma = self.gamma if self.gamma is not None else DEFAULT_GAMMA**k
-        lam = self.gae_lambda if self.gae_lambda is not None else DEFAULT_GAE_LAMBDA**k
+        gamma = self.ppo.gamma if self.ppo.gamma is not None else DEFAULT_GAMMA**k
+        lam = self.ppo.gae_lambda if self.ppo.gae_lambda is not None else DEFAULT_GAE_LAMBDA**k
         return gamma, lam
 
     @property
     def anchor_span(self) -> int:
-        if self.anchor_steps is not None:
-            return self.anchor_steps
+        """The env steps over which the anchor decays."""
+        if self.ppo.anchor_steps is not None:
+            return self.ppo.anchor_steps
         return min(self.steps // 2, ANCHOR_SPAN_MAX)
+
+
+def _actor_steps(steps: int, rollout: int, warmup: int) -> int:
+    """The env steps the actor learns from in a run of ``steps`` (whole rollouts of
+    ``rollout``) whose critic warms up over ``warmup``: the updates whose rollout began at
+    or after the warm-up's end."""
+    updates, held = -(-steps // rollout), -(-warmup // rollout)
+    return max(0, updates - held) * rollout
 
 
 def batch_that_fits(rollout: int, batch: int) -> int:

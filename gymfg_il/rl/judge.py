@@ -3,13 +3,8 @@ the held-out seeds by ``evaluation.runner.evaluate``, the code ``eval`` runs, so
 the curve is what ``eval --policy`` would report; and the curve's plot.
 
 The curve is the first ``eval_episodes`` seeds' success; the kept actor is chosen on more
-(``select_episodes``, those seeds and the next ones): on 16 episodes a success rate's spread is
-about 10 points, as wide as the actors' differences, and the best of twenty such draws is
-mostly the luckiest (docs/results/rl.md, "Choosing the kept actor on more episodes"). Or the
-kept actor is the mean of the weights of the actors evaluated in the run's late part
-(``Judge.average``, ``--keep average``): one actor's luck on a few episodes no longer picks
-it; steadier on the altitude by success, but it crashed more (docs/results/rl.md, "Averaging
-the late actors")."""
+(``select_episodes``, those seeds and the next ones): a success rate on a few episodes spreads
+as widely as the actors differ, and the best of many such draws is mostly the luckiest."""
 
 from __future__ import annotations
 
@@ -53,18 +48,14 @@ class Judge:
         more: list[int] | None = None,
         workers: Any = 1,
         keep_all: bool = False,
-        average_from: int | None = None,
     ) -> None:
         """``seeds``: the curve's; ``more``: the further seeds the kept actor is chosen on;
         ``workers``: processes (or a ``workers.Workers`` pool) to fly them on; ``keep_all``:
-        every evaluated actor stays in ``folder``/checkpoints/step-N; ``average_from``: the
-        actors evaluated from this env step on are kept for ``average`` (None: none)."""
+        every evaluated actor stays in ``folder``/checkpoints/step-N."""
         self.flight, self.seeds, self.start, self.folder = flight, seeds, start, folder
         self.more, self.workers, self.began = list(more or []), workers, began
-        self.keep_all, self.average_from = keep_all, average_from
+        self.keep_all = keep_all
         self.best: tuple[tuple[float, float], int, Any] | None = None  # score, step, actor
-        self.first: Any = None  # the start's actor (the first evaluated)
-        self.tail: list[tuple[int, dict[str, Any]]] = []  # (step, weights) to average
 
     def _fly(self, step: int, agent: Any, more: bool = True) -> EvalPoint:
         from gymfg_il.evaluation.metrics import summarize
@@ -93,14 +84,13 @@ class Judge:
 
         return self._fly(0, AgentSpec.controller(), more=False)
 
-    def __call__(self, actor: Any, step: int, more: bool = True, name: str = "") -> EvalPoint:
+    def __call__(self, actor: Any, step: int, more: bool = True) -> EvalPoint:
         """``actor`` evaluated at env ``step``, on the curve's seeds and (``more``) the
-        further ones. Named (``name``: the average), it is flown and saved under that name,
-        and is no candidate for ``best`` or ``average``."""
+        further ones; the best so far on all of them is kept (``best``)."""
         from gymfg_il.policies.checkpoint import save_policy
         from gymfg_il.rollout.agents import AgentSpec
 
-        path = self.folder / ("checkpoints" if self.keep_all else "") / (name or f"step-{step}")
+        path = self.folder / ("checkpoints" if self.keep_all else "") / f"step-{step}"
         module = as_ppo(actor)
         meta = {**meta_of(self.start), "name": path.name, "spec": self.flight.to_dict()}
         save_policy(
@@ -109,61 +99,20 @@ class Judge:
         point = self._fly(step, AgentSpec.policy(path), more)
         if not self.keep_all:
             shutil.rmtree(path, ignore_errors=True)
-        if name:
-            return point
-        if self.first is None:
-            self.first = module
-        if self.average_from is not None and step >= self.average_from and step > 0:
-            weights = {k: v.detach().clone() for k, v in module.state_dict().items()}
-            self.tail.append((step, weights))
         score = (point.select_success, point.select_return)
         if self.best is None or score > self.best[0]:
             self.best = (score, step, module)
         return point
 
-    def average(self) -> Any:
-        """The start's network with the mean of the weights of the actors evaluated from
-        ``average_from`` on (``mean_weights``)."""
-        import copy
 
-        if not self.tail or self.first is None:
-            raise RuntimeError("no evaluated actor to average: evaluate some first")
-        module = copy.deepcopy(self.first)
-        module.load_state_dict(mean_weights([weights for _, weights in self.tail]))
-        return module
-
-
-def mean_weights(parts: list[dict[str, Any]]) -> dict[str, Any]:
-    """The mean of several state dicts of one network (torch tensors), in float64 and cast
-    back, so that what is the same in all (the normalisations) stays exactly as it is."""
-    import torch
-
-    return {
-        k: torch.stack([w[k].double() for w in parts]).mean(0).to(v.dtype)
-        if v.is_floating_point()
-        else v
-        for k, v in parts[-1].items()
-    }
-
-
-def choose(keep: str, judge: Judge, curve: list[EvalPoint], last: Any) -> tuple[Any, ...]:
-    """(the kept actor's evaluation, the actor, the steps averaged into it: none unless
-    ``keep`` is ``average``) for ``PPORunConfig.keep``, ``last`` the actor after the last
-    update (evaluated last in ``curve``). The average is flown on all the selection seeds,
-    and the start is kept instead where it flew better there (by success, then return, as
-    ``best`` orders them)."""
+def choose(keep: str, judge: Judge, curve: list[EvalPoint], last: Any) -> tuple[EvalPoint, Any]:
+    """(the kept actor's evaluation, the actor) for ``PPORunConfig.keep``, ``last`` the actor
+    after the last update (evaluated last in ``curve``)."""
     if keep == "last":
-        return curve[-1], last, []
-    if keep == "best":
-        assert judge.best is not None
-        _, step, actor = judge.best
-        return next(p for p in curve if p.step == step), actor, []
-    average = judge.average()
-    point = judge(average, curve[-1].step, name="average")
-    start = curve[0]
-    if (point.select_success, point.select_return) < (start.select_success, start.select_return):
-        return curve[0], judge.first, []
-    return point, average, [step for step, _ in judge.tail]
+        return curve[-1], last
+    assert judge.best is not None
+    _, step, actor = judge.best
+    return next(p for p in curve if p.step == step), actor
 
 
 def plot_curve(
@@ -172,7 +121,6 @@ def plot_curve(
     title: str,
     path: Path,
     kept: EvalPoint | None = None,
-    kept_label: str = "kept",
 ) -> None:
     """Evaluated success and return against env steps, with the start (the first point) and
     the controller on the same seeds as lines; the success on all the seeds the kept actor is
@@ -199,7 +147,7 @@ def plot_curve(
             ax.plot([p.step for p in more], chosen, marker=".", alpha=0.7, label=label)
         if kept is not None:
             mark = scale * getattr(kept, chosen_key)
-            ax.plot([kept.step], [mark], marker="*", markersize=14, color="red", label=kept_label)
+            ax.plot([kept.step], [mark], marker="*", markersize=14, color="red", label="kept")
         ax.axhline(values[0], color="grey", linestyle="--", label="start")
         expert = scale * getattr(controller, key)
         ax.axhline(expert, color="green", linestyle=":", label="controller")

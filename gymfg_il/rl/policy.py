@@ -1,8 +1,8 @@
-"""A cloned MLP as stable-baselines3's actor-critic, for PPO fine-tuning (``rl.run``).
+"""A cloned MLP as stable-baselines3's actor-critic, for PPO fine-tuning (``rl.model``).
 
 The actor *is* the MLP policy (``policies.modeling_mlp``): the same network and the same
 normalisation, its output the mean of PPO's Gaussian, in the MLP's normalised action units.
-The env takes actions in those units (``rl.env.NormalizedActions``), so before any
+The env takes actions in those units (``rl.envs.normalized_actions``), so before any
 update PPO's mean action is, bit for bit, the action the cloned policy flies.
 
 Two things keep the first updates from undoing the cloning:
@@ -11,7 +11,7 @@ Two things keep the first updates from undoing the cloning:
 - an anchor: every optimiser step adds the gradient of ``anchor_weight`` x the mean squared
   distance between the actor's mean and the frozen starting policy's on the minibatch's
   observations (a BC term toward the start; for Gaussians of one fixed spread, their KL
-  divergence up to a constant). ``rl.run`` decays the weight to zero over the run.
+  divergence up to a constant). ``rl.algorithm`` decays the weight to zero over the run.
 
 The anchor enters through the optimiser (``AnchoredAdam``) because stable-baselines3's PPO
 sums a fixed set of losses; its gradient is added after PPO's own gradient clipping.
@@ -23,11 +23,7 @@ import copy
 from typing import Any
 
 import torch
-from stable_baselines3.common.distributions import (
-    DiagGaussianDistribution,
-    Distribution,
-    StateDependentNoiseDistribution,
-)
+from stable_baselines3.common.distributions import Distribution, StateDependentNoiseDistribution
 from stable_baselines3.common.policies import ActorCriticPolicy
 from torch import nn
 
@@ -37,36 +33,32 @@ from gymfg_il.policies.normalize import Normalizer
 
 class _Pass(nn.Module):
     """stable-baselines3's ``mlp_extractor`` slot, left empty: actor and critic take the
-    raw observation and normalise it themselves; the actor its first ``n_actor`` columns
-    (the flight's observation), the critic all of them (with ``rl.env.EpisodeClock``, the
-    time as well)."""
+    raw observation and normalise it themselves."""
 
-    def __init__(self, width: int, n_actor: int) -> None:
+    def __init__(self, width: int) -> None:
         super().__init__()
-        self.latent_dim_pi, self.latent_dim_vf = n_actor, width
-        self.n_actor = n_actor
+        self.latent_dim_pi = self.latent_dim_vf = width
 
     def forward(self, x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        return x[..., : self.n_actor], x
+        return x, x
 
     def forward_actor(self, x: torch.Tensor) -> torch.Tensor:
-        return x[..., : self.n_actor]
+        return x
 
     def forward_critic(self, x: torch.Tensor) -> torch.Tensor:
         return x
 
 
 class Critic(nn.Module):
-    """The value network: the actor's observation normalisation (a copy, frozen) on the
-    flight's observation, then the ``extra`` columns that follow it (the episode's clock, in
-    [0, 1]) mapped to [-1, 1], then an MLP of ``hidden`` widths to one value."""
+    """The value network: the actor's observation normalisation (a copy, frozen), then an
+    MLP of ``hidden`` widths (tanh) to one value."""
 
-    def __init__(self, obs_norm: Normalizer, hidden: list[int], extra: int = 0) -> None:
+    def __init__(self, obs_norm: Normalizer, hidden: list[int]) -> None:
         super().__init__()
         self.obs_norm = copy.deepcopy(obs_norm)
         self.n_obs = int(self.obs_norm.mean.numel())
         layers: list[nn.Module] = []
-        width = self.n_obs + extra
+        width = self.n_obs
         for h in hidden:
             layers += [nn.Linear(width, h), nn.Tanh()]
             width = h
@@ -74,8 +66,7 @@ class Critic(nn.Module):
         self.net = nn.Sequential(*layers)
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        flight, extra = obs[..., : self.n_obs], obs[..., self.n_obs :]
-        out: torch.Tensor = self.net(torch.cat([self.obs_norm(flight), 2 * extra - 1], -1))
+        out: torch.Tensor = self.net(self.obs_norm(obs))
         return out
 
 
@@ -130,21 +121,19 @@ class AnchoredPolicy(ActorCriticPolicy):
         # stable-baselines3 types these slots as its own MLP and Linear layers; any module
         # with their interface fills them
         n_obs = start.n_obs
-        extra = self.features_dim - n_obs  # the clock's column, or none
-        assert extra >= 0, (self.features_dim, n_obs)
-        self.mlp_extractor = _Pass(self.features_dim, n_obs)  # type: ignore[assignment]
+        assert self.features_dim == n_obs, (self.features_dim, n_obs)
+        self.mlp_extractor = _Pass(n_obs)  # type: ignore[assignment]
         self.action_net = copy.deepcopy(start)
         self.action_net.train()
-        if isinstance(self.action_dist, StateDependentNoiseDistribution):
-            # gSDE: the noise is a linear map of the normalised observation, drawn anew every
-            # sde_sample_freq steps, so exploring moves the controls coherently for a while
-            # (a white noise on the elevator at 10 Hz averages out before the altitude moves)
-            _, self.log_std = self.action_dist.proba_distribution_net(
-                latent_dim=n_obs, latent_sde_dim=n_obs, log_std_init=self.log_std_init
-            )
-        else:
-            self.log_std = nn.Parameter(torch.full((start.n_act,), float(self.log_std_init)))
-        self.value_net = Critic(start.obs_norm, self._critic_hidden, extra)  # type: ignore[assignment]
+        # gSDE: the noise is a linear map of the normalised observation, drawn anew every
+        # sde_sample_freq steps, so exploring moves the controls coherently for a while
+        # (a white noise on the elevator at 10 Hz averages out before the altitude moves)
+        if not isinstance(self.action_dist, StateDependentNoiseDistribution):
+            raise TypeError("AnchoredPolicy explores with gSDE: build it with use_sde=True")
+        _, self.log_std = self.action_dist.proba_distribution_net(
+            latent_dim=n_obs, latent_sde_dim=n_obs, log_std_init=self.log_std_init
+        )
+        self.value_net = Critic(start.obs_norm, self._critic_hidden)  # type: ignore[assignment]
         # the start, frozen: a submodule, so it moves to the policy's device, and kept out
         # of the optimiser's groups
         self.anchor_net = copy.deepcopy(start).eval()
@@ -177,17 +166,15 @@ class AnchoredPolicy(ActorCriticPolicy):
         """PPO's distribution: the actor's mean; gSDE's noise features are the actor's
         normalised observation (the raw one would scale the noise by feet and knots)."""
         mean = self.action_net(latent_pi)
-        if isinstance(self.action_dist, StateDependentNoiseDistribution):
-            features = self.actor.obs_norm(latent_pi)
-            return self.action_dist.proba_distribution(mean, self.log_std, features)
-        assert isinstance(self.action_dist, DiagGaussianDistribution)
-        return self.action_dist.proba_distribution(mean, self.log_std)  # one pass of the actor
+        assert isinstance(self.action_dist, StateDependentNoiseDistribution)
+        features = self.actor.obs_norm(latent_pi)
+        return self.action_dist.proba_distribution(mean, self.log_std, features)
 
     def evaluate_actions(
         self, obs: torch.Tensor | dict[str, torch.Tensor], actions: torch.Tensor
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor | None]:
         assert isinstance(obs, torch.Tensor)  # a flight's observation is one vector
-        self._batch = obs[..., : self.actor.n_obs]  # the minibatch the anchor is computed on
+        self._batch = obs  # the minibatch the anchor is computed on
         return super().evaluate_actions(obs, actions)
 
     def anchor_loss(self) -> torch.Tensor | None:

@@ -33,27 +33,8 @@ class Start:
 
 def starting_policy(cfg: PPORunConfig) -> Start:
     """The actor to start from (``cfg.init``'s, or a fresh MLP) and the flight to train in;
-    a clear error for a policy that is not an MLP or a task or aircraft not its own. With
-    ``cfg.action_floor``, its action units are widened (``widen_actions``)."""
-    start = scratch_policy(cfg) if cfg.init is None else _cloned(cfg)
-    if cfg.action_floor is not None:
-        widen_actions(start.module, cfg.action_floor)
-    return start
-
-
-def widen_actions(module: Any, floor: tuple[float, ...]) -> None:
-    """Give each control a spread of at least ``floor`` (raw units, per control) in the
-    actor's normalised action units, flying as before: the last layer's outputs shrink by
-    as much as the spread grows. PPO explores and steps in those units, so a control the
-    demonstrations hardly moved (the throttle in still air) is no longer held nearly still."""
-    norm = module.action_norm
-    with torch.no_grad():
-        wider = torch.maximum(norm.std, torch.as_tensor(floor, dtype=norm.std.dtype))
-        shrink = norm.std / wider
-        last = module.net[-1]
-        last.weight.mul_(shrink[:, None])
-        last.bias.mul_(shrink)
-        norm.std.copy_(wider)
+    a clear error for a policy that is not an MLP or a task or aircraft not its own."""
+    return scratch_policy(cfg) if cfg.init is None else _cloned(cfg)
 
 
 def _cloned(cfg: PPORunConfig) -> Start:
@@ -83,31 +64,54 @@ def _cloned(cfg: PPORunConfig) -> Start:
             f"--init {cfg.init} records no flight spec (its dataset predates them): train it "
             "again on a dataset rebuilt with `collect recover`"
         )
-    own = FlightSpec.from_dict(meta["spec"])
-    if not own.is_solo:
-        raise ConfigError(f"--init {cfg.init} flies a team flight; PPO here trains solo flights")
-    for name, given in (("task", cfg.task), ("aircraft", cfg.aircraft), ("agent_hz", cfg.agent_hz)):
-        if given is not None and given != getattr(own, name):
-            raise ConfigError(
-                f"--{name.replace('_', '-')} {given}: {cfg.init} flies {name} "
-                f"{getattr(own, name)}; fine-tuning keeps the policy's own {name} (drop the "
-                f"flag, or start from a policy of {given})"
-            )
+    flight, notes = _flight_of(cfg, FlightSpec.from_dict(meta["spec"]))
     module, meta = load_policy(cfg.init)
     if getattr(module.config, "dropout", 0.0):
         raise ConfigError(
             f"--init {cfg.init} uses dropout ({module.config.dropout}); PPO's likelihoods need "
             "a network without it: train the MLP with --dropout 0"
         )
-    changes = {k: v for k, v in (("turbulence", cfg.turbulence), ("wind_kt", cfg.wind_kt))}
+    _check_observation(cfg, flight, meta)
+    return Start(module, meta, flight, notes)
+
+
+def _flight_of(cfg: PPORunConfig, own: FlightSpec) -> tuple[FlightSpec, list[str]]:
+    """The flight a run from a policy of flight ``own`` trains in: ``own``, with the flight
+    options ``cfg`` gives in place of its own (a note on each), its task, aircraft and rate
+    kept; a clear error where ``cfg`` asks another."""
+    if not own.is_solo:
+        raise ConfigError(f"--init {cfg.init} flies a team flight; PPO here trains solo flights")
+    asked = cfg.given()
+    for name in ("task", "aircraft", "agent_hz"):
+        if name in asked and asked[name] != getattr(own, name):
+            given = asked[name]
+            raise ConfigError(
+                f"--{name.replace('_', '-')} {given}: {cfg.init} flies {name} "
+                f"{getattr(own, name)}; fine-tuning keeps the policy's own {name} (drop the "
+                f"flag, or start from a policy of {given})"
+            )
+    changes = {k: v for k, v in asked.items() if v != getattr(own, k)}
     notes = [
         f"note: {cfg.init} was trained with {k}={getattr(own, k)!r}; training it with "
         f"{k}={v!r} as asked"
         for k, v in changes.items()
-        if v is not None and v != getattr(own, k)
     ]
-    flight = own.replace(**{k: v for k, v in changes.items() if v is not None})
-    return Start(module, meta, flight, notes)
+    return own.replace(**changes), notes
+
+
+def _check_observation(cfg: PPORunConfig, flight: FlightSpec, meta: dict[str, Any]) -> None:
+    """A clear error where the flight observes other variables than the policy was trained
+    on (a flight option that changes the task's observation)."""
+    env = flight.make_env()
+    names = list(env.task.observation_names)
+    env.close()
+    own = meta.get("observation_names")
+    if own is not None and list(own) != names:
+        raise ConfigError(
+            f"--init {cfg.init} observes {len(own)} variables ({', '.join(own)}); the flight "
+            f"asked observes {len(names)} ({', '.join(names)}): drop the flight option that "
+            "changes the task, or start from a policy trained on it"
+        )
 
 
 def scratch_policy(cfg: PPORunConfig) -> Start:
@@ -119,14 +123,7 @@ def scratch_policy(cfg: PPORunConfig) -> Start:
     from gymfg_il.rollout.agents import AgentSpec
     from gymfg_il.rollout.seeded import fly_many
 
-    options = FlightOptions(
-        aircraft=cfg.aircraft,
-        task=cfg.task,
-        agent_hz=cfg.agent_hz,
-        turbulence=cfg.turbulence,
-        wind_kt=cfg.wind_kt,
-    )
-    flight = options.flight()
+    flight = FlightOptions(**cfg.given()).flight()
     flown = [e.solo for e in fly_many(flight, AgentSpec.controller(), SCRATCH_SEEDS)]
     obs = np.vstack([t.observations for t in flown])
     act = np.vstack([t.actions for t in flown])

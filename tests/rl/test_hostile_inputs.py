@@ -145,7 +145,9 @@ def test_the_default_out_is_held_apart_too(bc_policy, tmp_path, monkeypatch, not
 
     shutil.copytree(bc_policy, tmp_path / "bc")
     monkeypatch.chdir(tmp_path / "bc")  # the default out, policies/ppo-..., lies inside it
-    cfg = PPORunConfig(init=Path("."), steps=64, envs=1, rollout_steps=64, batch_size=64)
+    cfg = PPORunConfig(
+        init=Path("."), steps=64, envs=1, rollout_steps=64, batch_size=64, critic_warmup=0
+    )
     with pytest.raises(ConfigError, match=r"--out policies/ppo-altitude-c172p lies inside"):
         train_ppo(cfg)
     assert not (tmp_path / "bc/policies").exists()
@@ -197,7 +199,7 @@ def test_a_killed_runs_scratch_folder_is_cleared_by_the_next_run(bc_policy, tmp_
         monkeypatch.setattr(tempfile, "tempdir", str(tmp))  # this process's temp folder
         cfg = PPORunConfig(
             init=bc_policy, out=tmp_path / "b", steps=64, envs=1, rollout_steps=64,
-            batch_size=64, eval_episodes=1, select_episodes=1, eval_every=64,
+            batch_size=64, eval_episodes=1, select_episodes=1, eval_every=64, critic_warmup=0,
         )  # fmt: skip
         train_ppo(cfg)
         assert (tmp_path / "b/config.json").is_file()

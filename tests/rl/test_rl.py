@@ -41,8 +41,8 @@ def test_the_actor_starts_as_the_cloned_policy(bc_policy, tmp_path):
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     from gymfg_il.policies.agent import PolicyAgent
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.run import make_model
+    from gymfg_il.rl.envs import make_env
+    from gymfg_il.rl.model import make_model
     from gymfg_il.rl.start import starting_policy, stats_of
 
     cfg = _short(bc_policy, tmp_path / "ppo")
@@ -60,7 +60,7 @@ def test_the_actor_starts_as_the_cloned_policy(bc_policy, tmp_path):
             mean = model.policy.get_distribution(batch).distribution.mean
             assert torch.equal(mean, bc.policy(batch))  # bit for bit, normalised
             normalised, _ = model.policy.predict(obs, deterministic=True)
-            raw = venv.envs[0].env.action(normalised)  # Monitor(NormalizedActions(env))
+            raw = venv.envs[0].env.action(normalised)  # Monitor(TransformAction(env))
             np.testing.assert_allclose(raw, np.clip(bc.act(obs), *_bounds(env)), atol=1e-5)
         env.close()
     finally:
@@ -96,7 +96,7 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     # the best evaluation's actor is kept (the start's, where nothing beat it), chosen on the
     # curve's two seeds and the next two: the start's point is the BC policy's on each
     best = max(curve, key=lambda p: (p.select_success, p.select_return))
-    kept_entry = {"which": "best", "step": best.step, "chosen_on": 4, "averaged": []}
+    kept_entry = {"which": "best", "step": best.step, "chosen_on": 4}
     assert config["rl"]["kept"] == {**kept_entry, "select_success": best.select_success}
     flight = FlightSpec.from_dict(config["spec"])  # the run's: in light turbulence
     for seeds, success, mean_return in (
@@ -148,50 +148,19 @@ def test_a_seeded_run_repeats(bc_policy, tmp_path):
     assert not all(torch.equal(runs[0][k], start[k]) for k in start)  # the actor learnt
 
 
-def test_the_kept_actor_can_be_the_mean_of_the_late_actors(bc_policy, tmp_path, capsys):
+def test_stable_baselines3s_own_sampler_trains_the_same_way(bc_policy, tmp_path):
     from safetensors.torch import load_file
 
-    from gymfg_il.evaluation.runner import evaluate
     from gymfg_il.rl.run import train_ppo
-    from gymfg_il.rollout.agents import AgentSpec
-    from gymfg_il.train import main
 
-    out = tmp_path / "ppo"
-    changes = dict(steps=3072, eval_every=1024, keep="average", average_from=0.3)
-    result = train_ppo(_short(bc_policy, out, checkpoints=True, **changes))
-    steps = [p.step for p in result.curve]
-    assert steps == [0, 1024, 2048, 3072]
-    # only the start and the average fly the selection seeds; the others the curve's two
-    assert [p.chosen_on for p in result.curve] == [4, 2, 2, 2]
-    kept = json.loads((out / "config.json").read_text())["rl"]["kept"]
-    assert kept["which"] == "average" and kept["averaged"] == [1024, 2048, 3072]
-    saved = load_file(str(out / "model.safetensors"))
-    parts = [load_file(str(out / "checkpoints" / f"step-{s}" / "model.safetensors")) for s in steps]
-    for k, v in saved.items():  # the mean of the three late actors, not of the start's
-        late = np.mean([p[k].double().numpy() for p in parts[1:]], axis=0)
-        np.testing.assert_allclose(v.numpy(), late, rtol=1e-6, atol=1e-7)
-    assert not np.allclose(saved["net.2.weight"], parts[-1]["net.2.weight"])  # no one actor
-    kept_too = load_file(str(out / "checkpoints" / "average" / "model.safetensors"))
-    assert all(torch.equal(kept_too[k], saved[k]) for k in saved)  # kept with the others
-    for k in ("obs_norm.mean", "obs_norm.std", "action_norm.std"):
-        assert torch.equal(saved[k], parts[0][k])  # the same in all: exactly as they were
-    # its figure is what eval gives it on the four selection seeds, and beats the start's
-    rows, _ = evaluate(_flight(bc_policy), {"avg": AgentSpec.policy(out)}, [7000, 7001, 7002, 7003])
-    assert rows[0]["success_rate"] == kept["select_success"] == result.kept.select_success
-    first, avg = result.curve[0], result.kept
-    assert (avg.select_success, avg.select_return) >= (first.select_success, first.select_return)
-    # an actor taught at a rate that wrecks it: the average flies worse, the start is kept
-    # (through the command line, as a user runs it)
-    more = ["--keep", "average", "--average-from", "0.3", "--actor-lr", "0.05"]
-    assert main([*_argv(bc_policy, tmp_path / "w", *more), "--steps", "3072"]) == 0
-    printed = capsys.readouterr()
-    assert "the mean of those from step 921 on (7000..7003)" in printed.err
-    assert "the actor of the start (the average flew worse on these seeds)" in printed.out
+    cfg = _short(bc_policy, tmp_path / "sb3", sampler="sb3", eval_every=10_000, keep="last")
+    result = train_ppo(cfg)
+    assert [p.step for p in result.curve] == [0, 1024] and result.steps == 1024
+    saved = load_file(str(tmp_path / "sb3" / "model.safetensors"))
     start = load_file(str(bc_policy / "model.safetensors"))
-    saved = load_file(str(tmp_path / "w" / "model.safetensors"))
-    assert all(torch.equal(saved[k], start[k]) for k in start)
-    with pytest.raises(ConfigError, match=r"average_from=1\.0 must lie in \[0, 1\)"):
-        PPORunConfig(init=bc_policy, keep="average", average_from=1.0)
+    assert not all(torch.equal(saved[k], start[k]) for k in start)  # the actor learnt
+    settings = json.loads((tmp_path / "sb3" / "config.json").read_text())["rl"]["settings"]
+    assert settings["sampler"] == "sb3" and settings["batch_size"] == 128
 
 
 def _flight(bc_policy):
@@ -203,13 +172,13 @@ def _flight(bc_policy):
 def test_the_critic_warms_up_before_the_actor_moves(bc_policy, tmp_path):
     from stable_baselines3.common.vec_env import DummyVecEnv
 
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.run import make_model
+    from gymfg_il.rl.envs import make_env
+    from gymfg_il.rl.model import make_model
     from gymfg_il.rl.start import starting_policy, stats_of
 
     cfg = PPORunConfig(
         init=bc_policy, envs=1, rollout_steps=64, batch_size=32, epochs=2, critic_warmup=128,
-        exploration="gaussian", seed=1,
+        seed=1,
     )  # fmt: skip
     start = starting_policy(cfg)
     action = stats_of(start.module, "action_norm")
@@ -245,7 +214,7 @@ def test_a_fine_tuned_actor_learns_at_a_third_of_the_critics_rate(bc_policy):
     assert PPORunConfig(init=bc_policy).actor_rate == 1e-4
     assert PPORunConfig(init=bc_policy, actor_lr=3e-4).actor_rate == 3e-4
     scratch = PPORunConfig(task="altitude", aircraft="c172p")
-    assert scratch.actor_rate == scratch.lr == 3e-4  # a fresh actor has nothing to keep
+    assert scratch.actor_rate == scratch.ppo.lr == 3e-4  # a fresh actor has nothing to keep
 
 
 def test_the_discount_looks_as_far_ahead_in_seconds_at_every_rate(bc_policy):
@@ -307,7 +276,7 @@ def test_train_bc_does_not_offer_ppo():
 
 def test_the_success_bonus_follows_the_verdict_eval_gives(bc_policy):
     from gymfg_il.evaluation.runner import evaluate
-    from gymfg_il.rl.env import make_env
+    from gymfg_il.rl.envs import make_env
     from gymfg_il.rl.start import starting_policy
     from gymfg_il.rollout.agents import AgentSpec
 
@@ -333,112 +302,3 @@ def test_the_success_bonus_follows_the_verdict_eval_gives(bc_policy):
             assert sum(rewards) == pytest.approx(episode["total_return"] + bonus, abs=1e-6)
             outcomes.add(episode["success"])
     assert outcomes == {True, False}  # both ways were checked
-
-
-def test_the_clock_is_the_critics_and_the_time_limit_ends_the_return(bc_policy, tmp_path):
-    from stable_baselines3.common.vec_env import DummyVecEnv
-
-    from gymfg_il.policies.agent import PolicyAgent
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.run import make_model
-    from gymfg_il.rl.start import starting_policy, stats_of
-
-    cfg = _short(bc_policy, tmp_path / "ppo", clock=True)
-    start = starting_policy(cfg)
-    action = stats_of(start.module, "action_norm")
-    spec = start.flight.to_dict()  # 30-s episodes at 10 Hz: 300 steps
-    env = make_env(spec, action["mean"], action["std"], 0.2, clock=True)
-    obs, _ = env.reset(seed=5)
-    n = start.module.n_obs
-    assert obs.shape == (n + 1,) and obs[-1] == 0.0
-    clocks, ends = [], []
-    for _ in range(300):
-        obs, _, terminated, truncated, _ = env.step(np.zeros(4, dtype=np.float32))
-        clocks.append(obs[-1])
-        ends.append((terminated, truncated))
-    assert clocks[149] == pytest.approx(0.5) and clocks[-1] == 1.0
-    # the limit is the task's end, not a cut to bootstrap past (no crash at neutral controls)
-    assert ends[-1] == (True, False) and not any(any(e) for e in ends[:-1])
-    venv = DummyVecEnv([lambda: env])
-    model = make_model(cfg, venv, start.module, tmp_path / "tb", "cpu", start.flight.agent_hz)
-    bc = PolicyAgent.load(bc_policy)
-    flown, _ = env.reset(seed=6)
-    batch = torch.as_tensor(np.vstack([flown, flown]), dtype=torch.float32)
-    batch[1, -1] = 1.0  # the same state at the time limit
-    now, then = (model.policy.get_distribution(b).distribution.mean for b in batch[:, None])
-    assert torch.equal(now, then)  # the actor never sees the clock
-    assert torch.equal(now, bc.policy(batch[:1, :n]))  # and starts as the clone
-    values = model.policy.predict_values(batch)
-    assert values[0].item() != values[1].item()  # the critic does
-    venv.close()
-
-
-def test_an_action_floor_widens_the_units_not_the_flight(bc_policy):
-    from gymfg_il.policies.agent import PolicyAgent
-    from gymfg_il.rl.start import starting_policy
-
-    floor = (0.0, 0.0, 0.0, 0.3)
-    start = starting_policy(PPORunConfig(init=bc_policy, action_floor=floor))
-    bc = PolicyAgent.load(bc_policy).policy
-    std = start.module.action_norm.std
-    assert std[3].item() == pytest.approx(0.3)  # the throttle PPO explores and steps in
-    assert torch.equal(std[:3], bc.action_norm.std[:3])  # the others as the data gave them
-    obs = bc.obs_norm.mean + bc.obs_norm.std * torch.randn(500, bc.n_obs)
-    torch.testing.assert_close(start.module.act(obs)[0], bc.act(obs)[0], atol=1e-5, rtol=0)
-    with pytest.raises(ConfigError, match="action_floor"):
-        PPORunConfig(init=bc_policy, action_floor=(0.0, 0.0, 0.0, 2.0))
-
-
-def test_the_stall_margin_costs_each_step_flown_near_the_stall(bc_policy):
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.start import starting_policy
-    from gymfg_il.sim.properties import INDEX
-
-    spec = starting_policy(PPORunConfig(init=bc_policy)).flight.to_dict()  # 30-s altitude
-    pulled = np.array([0.0, -0.6, 0.0, 0.0])  # stick back, throttle idle: the speed bleeds
-    runs = []
-    for margin in (0.0, 15.0):
-        env = make_env(spec, [0.0] * 4, [1.0] * 4, stall_margin_kt=margin)  # raw actions
-        env.reset(seed=4)
-        rewards, speeds, done = [], [], False
-        while not done:
-            _, reward, terminated, truncated, info = env.step(pulled)
-            rewards.append(reward)
-            speeds.append(env.unwrapped.world.slots[0].state[INDEX["airspeed_kts"]])
-            done = terminated or truncated
-        runs.append((np.array(rewards), np.array(speeds), info))
-    (plain, speeds, info), (costed, same_speeds, _) = runs
-    assert info["reason"] == "stalled" and np.array_equal(speeds, same_speeds)
-    slow = speeds < 50.0 + 15.0  # the c172p stalls below 50 kt
-    assert slow.any() and not slow.all()
-    assert costed == pytest.approx(plain - slow.astype(float), abs=1e-12)
-    with pytest.raises(ConfigError, match="stall_margin_kt=-5"):
-        PPORunConfig(init=bc_policy, stall_margin_kt=-5)
-
-
-def test_the_bank_limit_costs_each_step_banked_beyond_it(bc_policy):
-    from gymfg_il.rl.env import make_env
-    from gymfg_il.rl.start import starting_policy
-    from gymfg_il.sim.properties import INDEX
-
-    spec = starting_policy(PPORunConfig(init=bc_policy)).flight.to_dict()
-    rolled = np.array([0.4, 0.0, 0.0, 0.7])  # aileron held: the bank grows past the limit
-    runs = []
-    for limit in (0.0, 35.0):
-        env = make_env(spec, [0.0] * 4, [1.0] * 4, bank_limit_deg=limit)  # raw actions
-        env.reset(seed=4)
-        rewards, banks = [], []
-        for _ in range(60):
-            _, reward, terminated, truncated, _ = env.step(rolled)
-            rewards.append(reward)
-            banks.append(env.unwrapped.world.slots[0].state[INDEX["roll_deg"]])
-            if terminated or truncated:
-                break
-        runs.append((np.array(rewards), np.array(banks)))
-    (plain, banks), (costed, same_banks) = runs
-    assert np.array_equal(banks, same_banks)
-    steep = np.abs(banks) > 35.0
-    assert steep.any() and not steep.all()
-    assert costed == pytest.approx(plain - steep.astype(float), abs=1e-12)
-    with pytest.raises(ConfigError, match="bank_limit_deg=-5"):
-        PPORunConfig(init=bc_policy, bank_limit_deg=-5)

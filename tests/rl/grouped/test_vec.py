@@ -7,7 +7,6 @@ from functools import partial
 
 import numpy as np
 import pytest
-import torch
 
 pytest.importorskip("stable_baselines3")
 
@@ -16,8 +15,8 @@ from stable_baselines3.common.vec_env import SubprocVecEnv
 
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ActionError
-from gymfg_il.rl.env import make_env
-from gymfg_il.rl.vec import GroupedVecEnv, groups_of
+from gymfg_il.rl.envs import make_env
+from gymfg_il.rl.grouped.vec import GroupedVecEnv, groups_of
 
 
 def test_groups_split_the_envs_evenly_and_in_order():
@@ -87,79 +86,3 @@ def test_attributes_and_methods_reach_the_right_envs():
     finally:
         venv.close()
     assert not any(p.is_alive() for p in venv.processes)
-
-
-def _model(n_envs, tmp_path, episode_time_s=3.0):
-    """PPO around a fresh MLP (seed 0) on ``n_envs`` grouped envs (2 processes), reset."""
-    from stable_baselines3.common.vec_env import VecNormalize
-
-    from gymfg_il.policies.configuration_mlp import MLPConfig
-    from gymfg_il.policies.modeling_mlp import MLPPolicy
-    from gymfg_il.rl.config import PPORunConfig
-    from gymfg_il.rl.run import make_model
-
-    flight = FlightSpec.solo("c172p", "altitude", episode_time_s=episode_time_s)
-    n_obs = flight.make_env().observation_space.shape[0]
-    torch.manual_seed(0)
-    stats = [{"mean": np.zeros(n), "std": np.ones(n)} for n in (n_obs, 4)]
-    module = MLPPolicy(MLPConfig(hidden=[32, 32]), *stats)
-    fn = partial(make_env, flight.to_dict(), [0.0, 0.0, 0.0, 0.5], [0.3, 0.3, 0.3, 0.3], 0.2)
-    venv = GroupedVecEnv([fn] * n_envs, 2)
-    venv.seed(5)
-    venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=0.99)
-    cfg = PPORunConfig(
-        task="altitude", aircraft="c172p", envs=n_envs, rollout_steps=40, batch_size=40, seed=2
-    )
-    model = make_model(cfg, venv, module, tmp_path, "cpu", flight.agent_hz)
-    model.tensorboard_log = None
-    _, callback = model._setup_learn(10**6, callback=None)
-    return model, callback
-
-
-def _collect(model, callback, own):
-    from stable_baselines3 import PPO
-
-    collect = PPO.collect_rollouts if own else type(model).collect_rollouts
-    assert collect(model, model.env, callback, model.rollout_buffer, model.n_steps)
-    return model.rollout_buffer
-
-
-def test_rollouts_sampled_in_the_env_processes_are_stable_baselines3s(tmp_path):
-    # 3 s episodes: the 40 steps of each of 3 envs cross a time limit's cut, whose value is
-    # bootstrapped, and an auto-reset; the policy's spread is ~0, so both sample its mean
-    runs = []
-    for own in (True, False):
-        model, callback = _model(3, tmp_path / str(own))
-        with torch.no_grad():
-            model.policy.log_std.fill_(-30.0)
-        buffer = _collect(model, callback, own)
-        runs.append((model, buffer))
-        model.env.close()
-    (own, a), (grouped, b) = runs
-    assert a.episode_starts[1:].sum() >= 3  # every env reset within the rollout
-    for key in ("observations", "actions", "rewards", "values", "returns", "advantages"):
-        assert np.allclose(getattr(a, key), getattr(b, key), rtol=1e-4, atol=1e-4), key
-    assert np.array_equal(a.episode_starts, b.episode_starts)
-    assert own.num_timesteps == grouped.num_timesteps == 120
-    assert [e["l"] for e in own.ep_info_buffer] == [e["l"] for e in grouped.ep_info_buffer]
-    assert list(own.ep_success_buffer) == list(grouped.ep_success_buffer)
-    assert np.allclose(own.env.ret_rms.var, grouped.env.ret_rms.var, rtol=1e-4)
-
-
-def test_every_rollout_samples_the_policy_as_it_is_now(tmp_path):
-    model, callback = _model(4, tmp_path, episode_time_s=90.0)
-    try:
-        for _ in range(2):
-            buffer = _collect(model, callback, own=False)
-            obs = torch.as_tensor(buffer.observations.reshape(-1, buffer.obs_shape[0]))
-            actions = torch.as_tensor(buffer.actions.reshape(-1, 4))
-            with torch.no_grad():
-                values, log_prob, _ = model.policy.evaluate_actions(obs, actions)
-            assert np.allclose(values.numpy().ravel(), buffer.values.ravel(), atol=1e-5)
-            assert np.allclose(log_prob.numpy(), buffer.log_probs.ravel(), atol=1e-4)
-            # an update in between: the env processes must sample the new weights
-            with torch.no_grad():
-                for p in model.policy.actor.parameters():
-                    p.add_(0.05 * torch.randn_like(p))
-    finally:
-        model.env.close()

@@ -17,21 +17,21 @@ from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.policies.modeling_mlp import MLPPolicy
 from gymfg_il.rl.config import PPORunConfig
-from gymfg_il.rl.env import make_env
-from gymfg_il.rl.forward import NumpyActorCritic
-from gymfg_il.rl.run import make_model
-from gymfg_il.rl.sampling import sampling_copy
+from gymfg_il.rl.envs import make_env
+from gymfg_il.rl.grouped.forward import NumpyActorCritic
+from gymfg_il.rl.grouped.sampling import sampling_copy
+from gymfg_il.rl.model import make_model
 
 
-def _policy(tmp_path, exploration, clock):
+def _policy(tmp_path):
     flight = FlightSpec.solo("c172p", "altitude", episode_time_s=3.0)
     n_obs = flight.make_env().observation_space.shape[0]
     torch.manual_seed(0)
     rng = np.random.default_rng(0)
     stats = [{"mean": rng.normal(size=n), "std": rng.uniform(0.5, 2, size=n)} for n in (n_obs, 4)]
     module = MLPPolicy(MLPConfig(hidden=[32, 16]), *stats)
-    fn = partial(make_env, flight.to_dict(), [0.0] * 4, [0.3] * 4, 0.0, clock)
-    cfg = PPORunConfig(task="altitude", aircraft="c172p", exploration=exploration, clock=clock)
+    fn = partial(make_env, flight.to_dict(), [0.0] * 4, [0.3] * 4, 0.0)
+    cfg = PPORunConfig(task="altitude", aircraft="c172p")
     model = make_model(cfg, DummyVecEnv([fn]), module, tmp_path, "cpu", flight.agent_hz)
     policy = model.policy
     with torch.no_grad():  # a policy some updates away from its start, critic included
@@ -39,17 +39,12 @@ def _policy(tmp_path, exploration, clock):
             p.add_(0.1 * torch.randn_like(p))
     obs_mean, obs_std = stats[0]["mean"], stats[0]["std"]
     obs = (obs_mean + obs_std * rng.normal(size=(64, n_obs))).astype(np.float32)
-    if clock:
-        obs = np.concatenate([obs, rng.uniform(size=(64, 1)).astype(np.float32)], axis=1)
     model.env.close()
     return policy, obs
 
 
-@pytest.mark.parametrize(
-    ("exploration", "clock"), [("sde", False), ("sde", True), ("gaussian", False)]
-)
-def test_the_numpy_pass_samples_as_the_policy_does(tmp_path, exploration, clock):
-    policy, obs = _policy(tmp_path, exploration, clock)
+def test_the_numpy_pass_samples_as_the_policy_does(tmp_path):
+    policy, obs = _policy(tmp_path)
     sampler = NumpyActorCritic(sampling_copy(policy), np.random.default_rng(3))
     sampler.reset_noise(len(obs))
     action, value, log_prob = sampler(obs)
@@ -79,7 +74,7 @@ def test_the_numpy_pass_samples_as_the_policy_does(tmp_path, exploration, clock)
 
 
 def test_gsde_keeps_each_envs_noise_map_until_it_is_drawn_anew(tmp_path):
-    policy, obs = _policy(tmp_path, "sde", False)
+    policy, obs = _policy(tmp_path)
     sampler = NumpyActorCritic(sampling_copy(policy), np.random.default_rng(3))
     sampler.reset_noise(4)
     first, again = sampler(obs[:4])[0], sampler(obs[:4])[0]

@@ -1,0 +1,75 @@
+"""The envs PPO trains in: the policy's own flight, taking actions in the policy's normalised
+units (``normalized_actions``), its reward what ``rl.reward`` composes (``make_env``); and
+the vector env that samples them (``training_envs``): stable-baselines3's own, or the grouped
+sampler (``rl.grouped``).
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+from collections.abc import Callable
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.wrappers import TransformAction
+
+from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.rl import reward
+
+
+def normalized_actions(env: gym.Env, mean: np.ndarray, std: np.ndarray) -> gym.Env:
+    """``env`` taking actions in a policy's normalised units (``(action - mean) / std`` of its
+    dataset; a spread under 1e-6 counts as 1): it receives ``action * std + mean``. The
+    action space is the contract's box in those units, so PPO's clipping keeps every action
+    inside the contract."""
+    box = env.action_space
+    assert isinstance(box, gym.spaces.Box)
+    mean = np.asarray(mean, dtype=np.float64)
+    std = np.where(np.asarray(std) < 1e-6, 1.0, np.asarray(std, dtype=np.float64))
+    low, high = (box.low - mean) / std, (box.high - mean) / std
+    space = gym.spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
+    return TransformAction(env, _Denormalize(mean, std), space)
+
+
+class _Denormalize:
+    """A normalised action back in the env's units (a class: picklable, unlike a lambda)."""
+
+    def __init__(self, mean: np.ndarray, std: np.ndarray) -> None:
+        self.mean, self.std = mean, std
+
+    def __call__(self, action: np.ndarray) -> np.ndarray:
+        raw: np.ndarray = np.asarray(action, dtype=np.float64) * self.std + self.mean
+        return raw
+
+
+def make_env(
+    spec: dict[str, Any], mean: list[float], std: list[float], success_bonus: float = 0.0
+) -> gym.Env:
+    """One training env (picklable, built in its own process): the flight ``spec`` taking
+    actions in the policy's normalised units, its episodes' task returns logged
+    (stable-baselines3's ``Monitor``, ``rollout/ep_rew_mean``), its reward with the success
+    bonus (``rl.reward.per_env``)."""
+    from stable_baselines3.common.monitor import Monitor
+
+    flight = FlightSpec.from_dict(spec)
+    env = normalized_actions(flight.make_env(), np.array(mean), np.array(std))
+    return reward.per_env(Monitor(env), success_bonus)
+
+
+def training_envs(env_fn: Callable[[], gym.Env], n: int, sampler: str = "grouped") -> Any:
+    """``n`` envs built by ``env_fn``, as ``train ppo`` samples them: a single env in this
+    process; else, for the ``grouped`` sampler, grouped in one process per core
+    (``rl.grouped.GroupedVecEnv``), for ``sb3``, stable-baselines3's ``SubprocVecEnv`` (one
+    process per env). Both seed env k with seed + k and step it the same."""
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    if n == 1:
+        return DummyVecEnv([env_fn])
+    if sampler == "sb3":
+        method = "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
+        return SubprocVecEnv([env_fn] * n, start_method=method)
+    from gymfg_il.rl.grouped.vec import GroupedVecEnv
+
+    return GroupedVecEnv([env_fn] * n, len(os.sched_getaffinity(0)))
