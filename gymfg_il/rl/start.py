@@ -40,13 +40,11 @@ def starting_policy(cfg: PPORunConfig) -> Start:
 def _cloned(cfg: PPORunConfig) -> Start:
     assert cfg.init is not None
     from gymfg_il.policies.checkpoint import load_policy, read_config
+    from gymfg_il.policies.lerobot_checkpoint import find_pretrained
 
-    meta = read_config(cfg.init) if (cfg.init / "config.json").is_file() else None
-    if meta is None:
-        raise ConfigError(
-            f"--init {cfg.init}: not a policy of ours (no config.json); give a folder "
-            "`train bc --policy mlp` wrote"
-        )
+    # a LeRobot run's folder says it is one (its checkpoint is inside); a FIFO or a missing
+    # config.json is named by read_config
+    meta = read_config(find_pretrained(cfg.init) or cfg.init)
     settings = meta["policy"]
     if not isinstance(settings, dict):
         raise ConfigError(

@@ -239,6 +239,11 @@ def test_ppo_says_a_lerobot_checkpoint_cannot_be_its_start(act_checkpoint, tmp_p
     assert train.main(argv) == 2
     one_error(capsys, "is a LeRobot checkpoint ('act')", "mlp, ppo", "cannot start from")
     assert not (tmp_path / "p").exists()
+    run = tmp_path / "run"  # lerobot-train's output folder: its checkpoint is inside
+    shutil.copytree(act_checkpoint, run / "checkpoints/last/pretrained_model")
+    argv[2] = str(run)
+    assert train.main(argv) == 2
+    one_error(capsys, "is a LeRobot checkpoint ('act')")
 
 
 # --- train bc on damaged or non-finite datasets -------------------------------------------
