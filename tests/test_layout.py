@@ -24,7 +24,7 @@ LAYERS = [
     {"rollout"},
     {"recording"},
     {"datasets"},
-    {"collectors"},
+    {"collectors", "cockpit"},
     {"learning"},
     {"evaluation", "export", "rl"},
     {"cli", "collect", "train", "eval", "serve", "demo", "lerobot_env"},
@@ -87,8 +87,13 @@ def old_paths() -> set[str]:
 
 def test_the_old_paths_are_the_ones_users_were_told_about():
     assert old_paths() == {
+        "gymfg_il.collectors.manual_keys",
+        "gymfg_il.collectors.timing",
+        "gymfg_il.collectors.updater",
         "gymfg_il.controllers.agent",
         "gymfg_il.manual.cockpit",
+        "gymfg_il.manual.gui",
+        "gymfg_il.manual.pfd",
         "gymfg_il.viz.flightgear",
         "gymfg_il.viz.multiplayer",
         "gymfg_il.viz.netfdm",

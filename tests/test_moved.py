@@ -14,6 +14,11 @@ MOVED = {  # old module -> (new module, a name users import from it)
     "gymfg_il.viz.peers": ("gymfg_il.flightgear.peers", "MultiplayerConfig"),
     "gymfg_il.viz.multiplayer": ("gymfg_il.flightgear.multiplayer", "TrafficSender"),
     "gymfg_il.manual.cockpit": ("gymfg_il.flightgear.cockpit", "CockpitReceiver"),
+    "gymfg_il.manual.gui": ("gymfg_il.cockpit.windows.gui", "ControlsGUI"),
+    "gymfg_il.manual.pfd": ("gymfg_il.cockpit.windows.pfd", "PrimaryFlightDisplay"),
+    "gymfg_il.collectors.manual_keys": ("gymfg_il.cockpit.inputs.keys", "help_lines"),
+    "gymfg_il.collectors.timing": ("gymfg_il.cockpit.timing", "EpisodeTiming"),
+    "gymfg_il.collectors.updater": ("gymfg_il.cockpit.updater", "DatasetUpdater"),
 }
 
 

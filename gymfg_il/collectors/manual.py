@@ -21,12 +21,13 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.cockpit.inputs.keys import COMMAND_KEYS, help_lines
+from gymfg_il.cockpit.timing import WARN_S, EpisodeTiming
+from gymfg_il.cockpit.updater import DatasetUpdater
+from gymfg_il.cockpit.windows.gui import ControlsGUI
 from gymfg_il.collectors.config import ManualConfig
-from gymfg_il.collectors.manual_keys import COMMAND_KEYS, help_lines
 from gymfg_il.collectors.manual_view import window_frame
 from gymfg_il.collectors.session import DATASET, check_appendable, check_out_folder
-from gymfg_il.collectors.timing import WARN_S, EpisodeTiming
-from gymfg_il.collectors.updater import DatasetUpdater
 from gymfg_il.display.briefing import Debrief, briefing, debrief
 from gymfg_il.display.readings import Display, display_of
 from gymfg_il.envs.flight import FlightSpec
@@ -40,7 +41,6 @@ from gymfg_il.manual.bindings import (
 )
 from gymfg_il.manual.controller import ManualController
 from gymfg_il.manual.devices import check_person_can_fly
-from gymfg_il.manual.gui import ControlsGUI
 from gymfg_il.manual.takeover import Takeover
 from gymfg_il.recording.recorder import new_log_path
 from gymfg_il.recording.session import session_record

@@ -8,8 +8,8 @@ from __future__ import annotations
 import dataclasses
 from typing import TYPE_CHECKING
 
+from gymfg_il.cockpit.windows.gui import GuiFrame
 from gymfg_il.display.readings import Display
-from gymfg_il.manual.gui import GuiFrame
 from gymfg_il.sim.properties import BY_NAME, INDEX
 from gymfg_il.tasks.scenery import Landmark, landmarks_of
 

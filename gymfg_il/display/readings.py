@@ -5,8 +5,8 @@ on and its role there: the aircraft's own value (``value``: the pointer of a tap
 attitude), a target (``bug``: a magenta mark on that instrument), a needle (``needle``: an
 ILS deviation in dots) or a line of the guidance panel (``guidance``: a number with its
 words). ``display_of(task, state, step)`` gives every reading for one task and state; the
-window draws exactly these (``manual.gui`` records what it drew, and a test holds it to the
-model), and the synthetic pilot reads only these (``manual.perception``).
+window draws exactly these (``cockpit.windows.gui`` records what it drew, and a test holds it
+to the model), and the synthetic pilot reads only these (``manual.perception``).
 
 Values keep the catalogue's units (``vertical_speed_fps`` in ft/s, distances in ft); the
 instrument draws them the way pilots read them (ft/min, NM).

@@ -246,7 +246,7 @@ def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
 
 def test_the_dataset_helper_builds_on_request_and_outlives_a_crash(tmp_path, caplog):
     from gymfg_il import collect
-    from gymfg_il.collectors.updater import DatasetUpdater
+    from gymfg_il.cockpit.updater import DatasetUpdater
 
     argv = ["autopilot", "--episodes", "2", "--episode-time", "2", "--out", str(tmp_path)]
     assert collect.main([*argv, "--no-progress"]) == 0
@@ -310,7 +310,7 @@ def test_trim_keys_move_the_neutral_the_surface_stays_on(tmp_path):
 
 
 def test_the_help_names_the_trim_keys():
-    from gymfg_il.collectors.manual_keys import help_lines
+    from gymfg_il.cockpit.inputs.keys import help_lines
     from gymfg_il.manual.bindings import KeyboardBindings
 
     text = "\n".join(help_lines("keyboard", KeyboardBindings()))

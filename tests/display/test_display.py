@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
+from gymfg_il.cockpit.windows.gui import ControlsGUI, GuiFrame, spoken
 from gymfg_il.display.briefing import briefing, debrief
 from gymfg_il.display.guidance import reading_names
 from gymfg_il.display.readings import PRIMARY, display_of
-from gymfg_il.manual.gui import ControlsGUI, GuiFrame, spoken
 from gymfg_il.manual.perception import MOTION, DisplayIntent
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.tasks.library import TASK_FAMILIES
