@@ -24,7 +24,8 @@ LAYERS = [
     {"rollout"},
     {"recording"},
     {"datasets"},
-    {"collectors", "cockpit"},
+    {"collectors"},
+    {"cockpit"},
     {"learning"},
     {"evaluation", "export", "rl"},
     {"cli", "collect", "train", "eval", "serve", "demo", "lerobot_env"},
@@ -87,7 +88,11 @@ def old_paths() -> set[str]:
 
 def test_the_old_paths_are_the_ones_users_were_told_about():
     assert old_paths() == {
+        "gymfg_il.collectors.manual",
         "gymfg_il.collectors.manual_keys",
+        "gymfg_il.collectors.manual_view",
+        "gymfg_il.collectors.screenshot",
+        "gymfg_il.collectors.synthetic",
         "gymfg_il.collectors.timing",
         "gymfg_il.collectors.updater",
         "gymfg_il.controllers.agent",

@@ -120,7 +120,7 @@ def test_every_library_task_is_checked_here():
 
 
 def test_the_next_gate_is_highlighted_in_the_view(make_env):
-    from gymfg_il.collectors.manual_view import next_gate_marked
+    from gymfg_il.cockpit.windows.pygame_window import next_gate_marked
     from gymfg_il.tasks.scenery import landmarks_of
 
     env, display = started(make_env, "waypoints")

@@ -74,81 +74,100 @@ class ControlsGUI:
         self.screen.blit(surf, pos)
 
     def draw(self, f: GuiFrame) -> None:
+        """Draw one frame and show it."""
+        self.screen.fill(BG)
+        self._controls(f.action, f.trim)
+        self._status(f)
+        # the primary flight display, every target a magenta bug on its instrument, and
+        # the task's guidance below it
+        self.drawn = set()
+        if f.display is not None:
+            self.drawn |= self.pfd.draw(self.screen, self.pg.Rect(430, 50, 440, 350), f.display)
+            self._panel(f.display, self.pg.Rect(372, 416, 520, 170))
+        self._words(f)
+        if f.view is not None:
+            self._view(f.view)
+        self._overlay(f)
+        self.pg.display.flip()
+
+    def _controls(self, a: np.ndarray, trim: np.ndarray | None) -> None:
+        """The stick (aileron right, elevator positive: nose down, stick forward, drawn up),
+        the rudder bar under it, the trim's ticks on both and the throttle's bar."""
         pg, s = self.pg, self.screen
-        s.fill(BG)
-        # stick: aileron right, elevator positive (nose down, stick forward) drawn up
         box = pg.Rect(40, 60, 240, 240)
         pg.draw.rect(s, DIM, box, 1)
         pg.draw.line(s, DIM, box.midtop, box.midbottom)
         pg.draw.line(s, DIM, box.midleft, box.midright)
-        a = f.action
         dot = (box.centerx + a[0] * box.width / 2, box.centery - a[1] * box.height / 2)
         pg.draw.circle(s, ACCENT, (int(dot[0]), int(dot[1])), 9)
-        if f.trim is not None:  # the trim: ticks on the box's left edge and the rudder bar
-            ty = int(box.centery - f.trim[1] * box.height / 2)
+        if trim is not None:  # the trim: ticks on the box's left edge and the rudder bar
+            ty = int(box.centery - trim[1] * box.height / 2)
             pg.draw.line(s, AMBER, (box.left - 10, ty), (box.left + 6, ty), 3)
-            tx = int(40 + 120 + f.trim[2] * 120)
+            tx = int(40 + 120 + trim[2] * 120)
             pg.draw.line(s, AMBER, (tx, 348), (tx, 356), 3)
         self._text("stick (aileron, elevator)", (40, 36), DIM, self.small)
-        # rudder: horizontal bar under the stick
         rud = pg.Rect(40, 330, 240, 18)
         pg.draw.rect(s, DIM, rud, 1)
         x = rud.centerx + a[2] * rud.width / 2
         pg.draw.line(s, AMBER, (x, rud.top), (x, rud.bottom), 4)
         rudder = f"rudder {a[2]:+.2f}"
-        if f.trim is not None:
-            rudder += f"   trim: elevator {f.trim[1]:+.2f}  rudder {f.trim[2]:+.2f}"
+        if trim is not None:
+            rudder += f"   trim: elevator {trim[1]:+.2f}  rudder {trim[2]:+.2f}"
         self._text(rudder, (40, 358), DIM, self.small)
-        # throttle: vertical bar
         thr = pg.Rect(300, 60, 26, 240)
         pg.draw.rect(s, DIM, thr, 1)
         h = int(a[3] * thr.height)
         pg.draw.rect(s, GREEN, (thr.left + 1, thr.bottom - h, thr.width - 2, h))
         self._text(f"throttle {a[3]:.2f}", (286, 306), DIM, self.small)
         self._text(f"aileron {a[0]:+.2f}   elevator {a[1]:+.2f}", (40, 380), FG, self.small)
-        # status line
+
+    def _status(self, f: GuiFrame) -> None:
+        """The status line: recording or not, the episode, the time left, who flies."""
         color = {"recording": RED, "paused": AMBER, "saving": ACCENT}.get(f.status, DIM)
         label = "REC" if f.status == "recording" else f.status.upper()
-        pg.draw.circle(s, color, (372, 30), 8)
+        self.pg.draw.circle(self.screen, color, (372, 30), 8)
         self._text(
             f"{label}   episode {f.episode}   {f.time_left_s:5.1f} s left   pilot: {f.pilot}",
             (388, 20),
             FG,
         )
-        # the primary flight display, every target a magenta bug on its instrument, and
-        # the task's guidance below it
-        self.drawn = set()
-        if f.display is not None:
-            self.drawn |= self.pfd.draw(s, pg.Rect(430, 50, 440, 350), f.display)
-            self._panel(f.display, pg.Rect(372, 416, 520, 170))
+
+    def _words(self, f: GuiFrame) -> None:
+        """The briefing or debrief at the bottom, and the state variables under the stick
+        (names aligned, values aligned)."""
         y = self.size[1] - 100
         for line in f.notes[:5]:
             color = GREEN if line.startswith("SUCCESS") else RED if line.startswith("FAIL") else FG
             self._text(line, (40, y), color, self.small)
             y += 19
-        # state variables under the stick: names aligned, values aligned
         y = 404
         for name, (value, unit) in f.variables.items():
             self._text(name, (40, y), DIM, self.small)
             self._text(f"{value:12.3f} {unit}", (200, y), FG, self.small)
             y += 18
-        if f.view is not None:
-            # the pilot's view, right of the instruments
-            h, w = f.view.shape[:2]
-            image = pg.image.frombuffer(np.ascontiguousarray(f.view).tobytes(), (w, h), "RGB")
-            s.blit(image, (self.size[0] - w - 20, 70))
-            pg.draw.rect(s, DIM, (self.size[0] - w - 21, 69, w + 2, h + 2), 1)
-            self._text("pilot's view", (self.size[0] - w - 20, 48), DIM, self.small)
+
+    def _view(self, view: np.ndarray) -> None:
+        """The pilot's view, right of the instruments."""
+        pg, s = self.pg, self.screen
+        h, w = view.shape[:2]
+        image = pg.image.frombuffer(np.ascontiguousarray(view).tobytes(), (w, h), "RGB")
+        s.blit(image, (self.size[0] - w - 20, 70))
+        pg.draw.rect(s, DIM, (self.size[0] - w - 21, 69, w + 2, h + 2), 1)
+        self._text("pilot's view", (self.size[0] - w - 20, 48), DIM, self.small)
+
+    def _overlay(self, f: GuiFrame) -> None:
+        """The message line, the help hint and, when asked, the help over everything."""
         if f.message:
             self._text(f.message, (40, self.size[1] - 128), AMBER)
         self._text("H: help", (self.size[0] - 80, self.size[1] - 30), DIM, self.small)
         if f.show_help and f.help_lines:
-            panel = pg.Surface((self.size[0] - 80, len(f.help_lines) * 22 + 30), pg.SRCALPHA)
+            panel = self.pg.Surface(
+                (self.size[0] - 80, len(f.help_lines) * 22 + 30), self.pg.SRCALPHA
+            )
             panel.fill((0, 0, 0, 215))
-            s.blit(panel, (40, 40))
+            self.screen.blit(panel, (40, 40))
             for i, line in enumerate(f.help_lines):
                 self._text(line, (60, 55 + 22 * i), FG, self.small)
-        pg.display.flip()
 
     def _panel(self, display: Display, rect: Any) -> None:
         """The task's targets and guidance in words, and the formation slot's diagram."""
