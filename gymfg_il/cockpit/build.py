@@ -8,9 +8,7 @@ get input (``manual.devices``); every refusal comes before the session folder is
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -44,9 +42,7 @@ from gymfg_il.manual.devices import check_person_can_fly
 from gymfg_il.manual.perception import DisplayIntent
 from gymfg_il.manual.synthetic import SyntheticPilot
 from gymfg_il.manual.takeover import Takeover
-from gymfg_il.recording.recorder import new_log_path
 from gymfg_il.recording.session import session_record
-from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.loop import Rollout
 from gymfg_il.viz.camera import Camera
@@ -97,7 +93,9 @@ def build(
     person = "synthetic" if synthetic else "human"
     assistant = _assistant_name(config.assist)
     source = person if assistant is None else f"{assistant}+{person}"
-    record = partial(_open_log, flight, source, human.device, images, config)
+    record = session_record(
+        flight, source, device=human.device, images=images, image_size=config.image_size
+    )
     log = _flight_log(config, env, flight, record, source, realtime)
     updater = DatasetUpdater(config.out)
     stats = SessionStats()
@@ -214,21 +212,11 @@ def _check_assist_rate(meta: dict[str, Any], flight: FlightSpec, path: Path) -> 
         )
 
 
-def _open_log(
-    flight: FlightSpec, source: str, device: str, images: list[str], config: ManualConfig
-) -> TrajectoryWriter:
-    """The session's MCAP log (opened when the first episode starts)."""
-    record = session_record(
-        flight, source, device=device, images=images, image_size=config.image_size
-    )
-    return TrajectoryWriter(new_log_path(config.out, "manual"), record)
-
-
 def _flight_log(
     config: ManualConfig,
     env: AircraftEnv,
     flight: FlightSpec,
-    record: Callable[[], TrajectoryWriter],
+    record: dict[str, Any],
     source: str,
     realtime: bool,
 ) -> FlightLog:
@@ -238,6 +226,7 @@ def _flight_log(
         named = f"synthetic-{config.skill:g}" if config.pilot == "synthetic" else ""
     tracked = env.task.tracked()
     return FlightLog(
+        config.out,
         record,
         env.task,
         env.dt,

@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from gymfg_il.cockpit.timing import WARN_S, EpisodeTiming
 from gymfg_il.display.briefing import Debrief, debrief
+from gymfg_il.recording.recorder import new_log_path
 from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.records import Start, Tick
 
@@ -26,8 +27,9 @@ class FlightLog:
     """The session's log and the episode being flown.
 
     Args:
-        open_log: makes the session's ``TrajectoryWriter`` (called at the first episode, so
-            a session quit before flying leaves no log).
+        out: the session folder; the log is opened in its ``logs/`` when the first episode
+            starts (a session quit before flying leaves no log).
+        record: the log's session record (``recording.session.session_record``).
         task: the bound task, which judges each episode.
         dt: seconds per agent step.
         source: who flies (``human``, ``synthetic``, ``controller+human``, ...).
@@ -40,7 +42,8 @@ class FlightLog:
 
     def __init__(
         self,
-        open_log: Callable[[], TrajectoryWriter],
+        out: Path,
+        record: dict[str, Any],
         task: Any,
         dt: float,
         *,
@@ -51,7 +54,7 @@ class FlightLog:
         error_at: int | None,
         throttle: float,
     ) -> None:
-        self.open_log, self.task, self.dt = open_log, task, dt
+        self.out, self.record, self.task, self.dt = out, record, task, dt
         self.source, self.pilot_name, self.realtime = source, pilot_name, realtime
         self.gusty, self.error_at = gusty, error_at
         self.writer: TrajectoryWriter | None = None
@@ -66,7 +69,7 @@ class FlightLog:
 
     def _writer(self) -> TrajectoryWriter:
         if self.writer is None:
-            self.writer = self.open_log()
+            self.writer = TrajectoryWriter(new_log_path(self.out, "manual"), self.record)
         return self.writer
 
     def start(self, seed: int, starts: list[Start]) -> None:
