@@ -37,8 +37,8 @@ def _xdo(*args: str) -> str:
 def measure(presses: int, seed: int = 0) -> dict[str, Any]:
     """Fly ``presses`` presses of Left; each one's latency (module docstring)."""
     os.environ.pop("SDL_VIDEODRIVER", None)  # the real window
+    from gymfg_il.cockpit.session import ManualSession
     from gymfg_il.collectors.config import ManualConfig
-    from gymfg_il.collectors.manual import ManualSession
 
     starts: list[float] = []  # perf_counter (CLOCK_MONOTONIC, as time.monotonic) per frame
     recorded: list[float] = []  # the aileron recorded by the frame before each
@@ -46,8 +46,8 @@ def measure(presses: int, seed: int = 0) -> dict[str, Any]:
 
     def on_frame(frame: int, session: ManualSession) -> None:
         starts.append(time.perf_counter())
-        flying = session.state == "recording"
-        recorded.append(float(session.last_action[0]) if flying else float("nan"))
+        flying = session.stages.phases.state == "recording"
+        recorded.append(float(session.stages.log.last_action[0]) if flying else float("nan"))
 
     def press() -> None:
         rng = random.Random(seed)

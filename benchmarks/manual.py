@@ -20,8 +20,8 @@ def manual_loop(seconds: float) -> Row:
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     import pygame
 
+    from gymfg_il.cockpit.session import ManualSession
     from gymfg_il.collectors.config import ManualConfig
-    from gymfg_il.collectors.manual import ManualSession
 
     frames = int(seconds * 30)
     keys = [pygame.K_LEFT, pygame.K_UP, pygame.K_RIGHT, pygame.K_DOWN]
@@ -62,8 +62,8 @@ def synthetic_pilot(seconds: float) -> Row:
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     import time
 
+    from gymfg_il.cockpit.session import ManualSession
     from gymfg_il.collectors.config import ManualConfig
-    from gymfg_il.collectors.manual import ManualSession
 
     with tempfile.TemporaryDirectory() as tmp:
         cfg = ManualConfig(

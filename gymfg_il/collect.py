@@ -218,7 +218,7 @@ def _fly_by_hand(cfg: ManualConfig, show_progress: bool = True) -> int:
     import os
 
     from gymfg_il import cli
-    from gymfg_il.collectors.manual import ManualSession
+    from gymfg_il.cockpit.session import ManualSession
 
     if cfg.pilot == "person":
         session = ManualSession(cfg)
@@ -229,17 +229,13 @@ def _fly_by_hand(cfg: ManualConfig, show_progress: bool = True) -> int:
         )
         stats = session.run()
     else:  # the synthetic pilot: headless, as fast as the machine allows
-        from gymfg_il.collectors.synthetic import SyntheticDriver
-
         os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-        driver = SyntheticDriver(cfg.skill)
         bar = cli.progress_bar(cfg.episodes, "episodes", "ep", show_progress)
 
-        def fly(frame: int, session: ManualSession) -> None:
-            driver(frame, session)
+        def progress(frame: int, session: ManualSession) -> None:
             bar.update(session.stats.saved - bar.n)
 
-        session = ManualSession(cfg, fly)
+        session = ManualSession(cfg, progress)
         try:
             stats = session.run()
         finally:

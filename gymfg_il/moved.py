@@ -8,17 +8,20 @@ from __future__ import annotations
 
 import importlib
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 
-def forward(old: str, new: str) -> Callable[[str], Any]:
+def forward(old: str, new: str, gone: Mapping[str, str] | None = None) -> Callable[[str], Any]:
     """The module ``__getattr__`` of the old module ``old``: each name comes from ``new``,
-    with a DeprecationWarning pointing at the line that used the old path."""
+    with a DeprecationWarning pointing at the line that used the old path. ``gone``: names
+    that have no new home, each with what replaced it (the AttributeError says so)."""
 
     def __getattr__(name: str) -> Any:
         if name.startswith("__"):  # module machinery (``__all__``, ``__wrapped__``, ...)
             raise AttributeError(f"module {old!r} has no attribute {name!r}")
+        if gone and name in gone:
+            raise AttributeError(f"{old}.{name} is gone: {gone[name]}")
         module = importlib.import_module(new)
         if not hasattr(module, name):
             raise AttributeError(f"module {old!r} (now {new}) has no attribute {name!r}")

@@ -26,6 +26,7 @@ LAYERS = [
     {"recording"},
     {"datasets"},
     {"collectors"},
+    {"cockpit"},
     {"learning"},
     {"evaluation", "export", "rl"},
     {"cli", "collect", "train", "eval", "serve", "demo", "lerobot_env"},
@@ -89,12 +90,21 @@ def old_paths() -> frozenset[str]:
 
 def test_the_old_paths_are_the_ones_users_were_told_about():
     assert old_paths() == {
+        "gymfg_il.collectors.manual",
+        "gymfg_il.collectors.manual_keys",
+        "gymfg_il.collectors.manual_view",
+        "gymfg_il.collectors.screenshot",
+        "gymfg_il.collectors.synthetic",
+        "gymfg_il.collectors.timing",
+        "gymfg_il.collectors.updater",
         "gymfg_il.controllers.agent",
         "gymfg_il.manual.cockpit",
         "gymfg_il.rl.env",
         "gymfg_il.rl.forward",
         "gymfg_il.rl.sampling",
         "gymfg_il.rl.vec",
+        "gymfg_il.manual.gui",
+        "gymfg_il.manual.pfd",
         "gymfg_il.viz.flightgear",
         "gymfg_il.viz.multiplayer",
         "gymfg_il.viz.netfdm",
@@ -115,3 +125,49 @@ def test_no_module_is_over_400_lines():
         if (n := len(p.read_text().splitlines())) > 400
     }
     assert not big, big
+
+
+# import circles inside a package left for other changes of #53 to remove (lazy imports inside
+# functions count: reading one module still means reading the other); no new one may appear
+KNOWN_CIRCLES = {
+    ("envs.flight", "envs.options", "envs.single"),
+    ("learning.data", "learning.data_checks"),
+    ("sim.simulation", "sim.trim"),
+    ("tasks.courses", "tasks.formation", "tasks.library", "tasks.scenery"),
+}
+
+
+def import_circles() -> list[tuple[str, ...]]:
+    """Groups of modules of one top-level package that import each other, each group as the
+    sorted module names without ``gymfg_il.`` (any import statement, top level or not)."""
+    names = {dotted(p): p for p in ROOT.rglob("*.py")}
+    edges = {
+        name: {m for m in imported_modules(path) if m in names and m != name}
+        for name, path in names.items()
+    }
+
+    def package(name: str) -> str:
+        return name.split(".")[1] if "." in name else ""
+
+    def reach(start: str) -> set[str]:
+        seen: set[str] = set()
+        todo = [start]
+        while todo:
+            for m in edges[todo.pop()]:
+                if m not in seen and package(m) == package(start):
+                    seen.add(m)
+                    todo.append(m)
+        return seen
+
+    reached = {name: reach(name) for name in names}
+    groups = {
+        tuple(sorted(m.removeprefix("gymfg_il.") for m in reached[n] if n in reached[m]))
+        for n in names
+        if n in reached[n]
+    }
+    return sorted(groups)
+
+
+def test_no_import_circle_inside_a_package():
+    new = [circle for circle in import_circles() if circle not in KNOWN_CIRCLES]
+    assert not new, new

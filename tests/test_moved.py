@@ -18,6 +18,15 @@ MOVED = {  # old module -> (new module, a name users import from it)
     "gymfg_il.rl.vec": ("gymfg_il.rl.grouped.vec", "GroupedVecEnv"),
     "gymfg_il.rl.forward": ("gymfg_il.rl.grouped.forward", "NumpyActorCritic"),
     "gymfg_il.rl.sampling": ("gymfg_il.rl.grouped.sampling", "sample_rollout"),
+    "gymfg_il.manual.gui": ("gymfg_il.cockpit.windows.gui", "ControlsGUI"),
+    "gymfg_il.manual.pfd": ("gymfg_il.cockpit.windows.pfd", "PrimaryFlightDisplay"),
+    "gymfg_il.collectors.manual": ("gymfg_il.cockpit.session", "ManualSession"),
+    "gymfg_il.collectors.manual_view": ("gymfg_il.cockpit.windows.pygame_window", "SHOWN"),
+    "gymfg_il.collectors.synthetic": ("gymfg_il.cockpit.inputs.synthetic_pilot", "SyntheticInput"),
+    "gymfg_il.collectors.screenshot": ("gymfg_il.cockpit.screenshot", "main"),
+    "gymfg_il.collectors.manual_keys": ("gymfg_il.cockpit.inputs.keys", "help_lines"),
+    "gymfg_il.collectors.timing": ("gymfg_il.cockpit.timing", "EpisodeTiming"),
+    "gymfg_il.collectors.updater": ("gymfg_il.cockpit.updater", "DatasetUpdater"),
 }
 
 
@@ -34,6 +43,24 @@ def test_a_name_the_new_home_lacks_is_an_attribute_error_naming_both():
     old = importlib.import_module("gymfg_il.viz.peers")
     with pytest.raises(AttributeError, match=r"gymfg_il\.viz\.peers.*gymfg_il\.flightgear\.peers"):
         old.NoSuchThing  # noqa: B018
+
+
+def test_a_name_with_no_new_home_says_what_replaced_it():
+    old = importlib.import_module("gymfg_il.collectors.synthetic")
+    with pytest.raises(AttributeError, match=r"SyntheticDriver is gone: .*pilot='synthetic'"):
+        old.SyntheticDriver  # noqa: B018
+
+
+def test_the_old_screenshot_command_runs_the_new_one_and_says_so():
+    proc = subprocess.run(
+        [sys.executable, "-m", "gymfg_il.collectors.screenshot", "--help"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "python -m gymfg_il.cockpit.screenshot" in proc.stdout
+    assert "use python -m gymfg_il.cockpit.screenshot" in proc.stderr
 
 
 def test_the_old_multiplayer_command_runs_the_new_one_and_says_so():

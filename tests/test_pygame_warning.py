@@ -25,6 +25,6 @@ def test_a_manual_run_prints_no_pkg_resources_warning(tmp_path):
 
 
 def test_the_gui_screenshot_prints_no_pkg_resources_warning(tmp_path):
-    done = run("gymfg_il.collectors.screenshot", str(tmp_path / "gui.png"))
+    done = run("gymfg_il.cockpit.screenshot", str(tmp_path / "gui.png"))
     assert (tmp_path / "gui.png").is_file()
     assert "pkg_resources" not in done.stderr, done.stderr

@@ -6,7 +6,7 @@
 #   approach_c172p_tracks.png  the approach's expert and two policies cloned from 50 of its
 #       demonstrations (MLP, chunking), ground track and vertical profile on seeds 5000-5001
 #   camera_strip.png  the headless camera along an approach (camera_strip.py)
-#   gui.png  the controls GUI in flight (python -m gymfg_il.collectors.screenshot)
+#   gui.png  the controls GUI in flight (python -m gymfg_il.cockpit.screenshot)
 #   window_approach.png, window_formation.png  the window 20 s into the approach and the
 #       formation, flown by the synthetic pilot from what the window shows (screenshot --task)
 #   flightgear.png  only with FLIGHTGEAR=1: FlightGear fed by JSBSim, from its test (needs fgfs
@@ -35,9 +35,9 @@ python -m gymfg_il.eval --policy "$D-mlp" --policy "$D-chunk" --episodes 2 --see
   --plots "$WORK/plots" --no-progress
 cp "$WORK/plots/approach_c172p_tracks.png" "$OUT/"
 python docs/experiments/camera_strip.py "$OUT/camera_strip.png"
-python -m gymfg_il.collectors.screenshot "$OUT/gui.png"
+python -m gymfg_il.cockpit.screenshot "$OUT/gui.png"
 for TASK in approach formation; do
-  python -m gymfg_il.collectors.screenshot "$OUT/window_$TASK.png" --task "$TASK"
+  python -m gymfg_il.cockpit.screenshot "$OUT/window_$TASK.png" --task "$TASK"
 done
 if [ "${FLIGHTGEAR:-0}" = 1 ]; then
   GYMFG_SCREENSHOT="$(realpath "$OUT")/flightgear.png" python -m pytest -q -m flightgear \

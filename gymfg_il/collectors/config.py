@@ -3,7 +3,7 @@
 ``CollectConfig`` holds what every collection has: the flight (``envs.options.FlightOptions``),
 the episodes and their seeds, the session folder, the dataset's camera views, and the
 autopilot's DART noise; ``collect autopilot`` is built from it. ``ManualConfig`` adds what a
-session flown through a device needs (``collect manual``, ``collectors.manual.ManualSession``):
+session flown through a device needs (``collect manual``, ``cockpit.session.ManualSession``):
 who is at the controls, the device and its bindings, an assistant, what the window shows.
 
 A recipe is a TOML file with a ``[collector]`` table holding these fields (``kind = "manual"``
@@ -135,7 +135,7 @@ MANUAL_HZ = 30
 @dataclass
 class ManualConfig(CollectConfig):
     """A collection session flown through a device in a window, by a person or the synthetic
-    pilot (``collectors.manual.ManualSession``).
+    pilot (``cockpit.session.ManualSession``).
 
     Attributes:
         device: keyboard, mouse, joystick or flightgear (fly from FlightGear's own cockpit:

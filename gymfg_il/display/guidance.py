@@ -1,5 +1,6 @@
 """Each task's readings beyond the primary instruments: its targets as bugs and the guidance a
-pilot expects for it (``display.readings`` says what a reading is).
+pilot expects for it, as lines (``Line``: a reading's declaration; ``display.readings`` says
+what a reading is and gives each line its value).
 
 - target tasks: the target as a bug on its instrument (a slip ball's mark for sideslip);
 - level: the start altitude and heading as bugs;
@@ -26,9 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
-from gymfg_il.display.readings import PRIMARY, Reading
+from gymfg_il.display.instruments import PRIMARY
 from gymfg_il.sim.properties import BY_NAME
 from gymfg_il.units import wrap_360
 
@@ -185,18 +184,6 @@ def guide(task: Any) -> tuple[tuple[Line, ...], Values]:
         return [o[line.name] for line in bugs]
 
     return bugs, _targets
-
-
-def task_readings(task: Any, state: np.ndarray, step: int) -> list[Reading]:
-    """``task``'s readings at agent ``step`` (the aircraft in catalogue-ordered ``state``)."""
-    lines, values = guide(task)
-    if not lines:
-        return []
-    observed = dict(zip(task.observation_names, task.observe(state, step).tolist(), strict=True))
-    return [
-        Reading(line.name, float(value), line.unit, line.instrument, line.role, line.label)
-        for line, value in zip(lines, values(task, observed), strict=True)
-    ]
 
 
 def reading_names(task: Any) -> tuple[str, ...]:

@@ -5,8 +5,8 @@ on and its role there: the aircraft's own value (``value``: the pointer of a tap
 attitude), a target (``bug``: a magenta mark on that instrument), a needle (``needle``: an
 ILS deviation in dots) or a line of the guidance panel (``guidance``: a number with its
 words). ``display_of(task, state, step)`` gives every reading for one task and state; the
-window draws exactly these (``manual.gui`` records what it drew, and a test holds it to the
-model), and the synthetic pilot reads only these (``manual.perception``).
+window draws exactly these (``cockpit.windows.gui`` records what it drew, and a test holds it
+to the model), and the synthetic pilot reads only these (``manual.perception``).
 
 Values keep the catalogue's units (``vertical_speed_fps`` in ft/s, distances in ft); the
 instrument draws them the way pilots read them (ft/min, NM).
@@ -20,19 +20,11 @@ from typing import Any
 
 import numpy as np
 
+from gymfg_il.display.guidance import guide
+from gymfg_il.display.instruments import PRIMARY
 from gymfg_il.sim.properties import BY_NAME, INDEX
 
 ROLES = ("value", "bug", "needle", "guidance")
-# the primary flight display: each flight variable and the instrument that shows it
-PRIMARY: dict[str, str] = {
-    "airspeed_kts": "airspeed",
-    "altitude_ft": "altitude",
-    "vertical_speed_fps": "vertical_speed",
-    "roll_deg": "bank",
-    "pitch_deg": "pitch",
-    "heading_deg": "heading",
-    "beta_deg": "slip",
-}
 
 
 @dataclass(frozen=True, slots=True)
@@ -92,12 +84,23 @@ def primary(state: np.ndarray) -> list[Reading]:
     ]
 
 
+def task_readings(task: Any, state: np.ndarray, step: int) -> list[Reading]:
+    """``task``'s readings at agent ``step`` (the aircraft in catalogue-ordered ``state``):
+    its guidance lines (``display.guidance``) with their values."""
+    lines, values = guide(task)
+    if not lines:
+        return []
+    observed = dict(zip(task.observation_names, task.observe(state, step).tolist(), strict=True))
+    return [
+        Reading(line.name, float(value), line.unit, line.instrument, line.role, line.label)
+        for line, value in zip(lines, values(task, observed), strict=True)
+    ]
+
+
 def display_of(task: Any, state: np.ndarray, step: int, flying: bool = True) -> Display:
     """What the window shows of ``task`` (a bound Task) at agent ``step`` of an episode, the
     aircraft in catalogue-ordered ``state``; only the primary instruments when not
     ``flying`` (before the first episode: no plan, no targets yet)."""
-    from gymfg_il.display.guidance import task_readings
-
     readings = primary(state)
     if flying:
         readings += task_readings(task, state, step)

@@ -25,9 +25,10 @@ pilot knows what the aircraft needs); how it gets there is human:
 ``Skill.of(level)`` sets all of these from one number, 0 (a novice) to 1 (an ace). The same
 seed makes the same pilot make the same mistakes, so its demonstrations reproduce.
 
-It flies through the real session loop (``collect manual --pilot synthetic``: its events go
-into pygame's queue) or as an Agent (``PilotAgent``: its events go straight to a
-ManualController), so evaluation can score it beside the controller and the policies.
+It flies through the real session loop (``collect manual --pilot synthetic``: its events are
+the session's input, ``cockpit.inputs.synthetic_pilot``) or as an Agent (``PilotAgent``: its
+events go straight to a ManualController), so evaluation can score it beside the controller
+and the policies.
 """
 
 from __future__ import annotations

@@ -10,8 +10,8 @@ import pytest
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 import pygame
 
+from gymfg_il.cockpit.session import ManualSession
 from gymfg_il.collectors.config import ManualConfig
-from gymfg_il.collectors.manual import ManualSession
 from gymfg_il.datasets.lerobot_api import open_metadata
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
@@ -168,8 +168,9 @@ def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
     drawn = []
 
     def spy(session):
-        draw = session.gui.draw
-        session.gui.draw = lambda frame: (drawn.append(frame), draw(frame))
+        gui = session.stages.window.gui
+        draw = gui.draw
+        gui.draw = lambda frame: (drawn.append(frame), draw(frame))
 
     def on_frame(frame, session):
         if frame == 1:
@@ -198,8 +199,9 @@ def test_the_window_says_how_an_episode_went(tmp_path):
 
     session = ManualSession(manual_config(tmp_path, episode_time_s=2), on_frame, realtime=False)
     session.run(max_frames=120)
-    assert session.debrief is not None and not session.debrief.success  # 2 s: not held yet
-    assert session.debrief.lines[0].startswith("FAILED: over the last 10 s")
+    said = session.stages.log.debrief
+    assert said is not None and not said.success  # 2 s: not held yet
+    assert said.lines[0].startswith("FAILED: over the last 10 s")
 
 
 def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
@@ -209,14 +211,17 @@ def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
         if frame == 1:
             key(pygame.K_SPACE)
         if frame in (2, 25):
-            shots[frame] = pygame.surfarray.array3d(session.gui.screen).transpose(1, 0, 2)
+            shots[frame] = pygame.surfarray.array3d(session.stages.window.gui.screen).transpose(
+                1, 0, 2
+            )
         if frame < 25:
             key(pygame.K_RIGHT)  # roll right: the horizon in the view turns
         if frame == 30:
             key(pygame.K_q)
 
     session = ManualSession(manual_config(tmp_path), on_frame, realtime=False)
-    assert session.gui.size == (1250, 700) and session.camera is not None
+    window = session.stages.window
+    assert window.gui.size == (1250, 700) and window.camera is not None
     session.run(max_frames=40)
     # the view's box right of the instruments: sky on top (blue), ground below (green)
     for shot in shots.values():
@@ -227,7 +232,8 @@ def test_the_window_shows_the_pilots_view_beside_the_instruments(tmp_path):
     headless = ManualSession(
         manual_config(tmp_path / "b", pilot_view="none"), driven, realtime=False
     )
-    assert headless.gui.size == (900, 700) and headless.camera is None
+    window = headless.stages.window
+    assert window.gui.size == (900, 700) and window.camera is None
 
 
 def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
@@ -246,7 +252,7 @@ def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
 
 def test_the_dataset_helper_builds_on_request_and_outlives_a_crash(tmp_path, caplog):
     from gymfg_il import collect
-    from gymfg_il.collectors.updater import DatasetUpdater
+    from gymfg_il.cockpit.updater import DatasetUpdater
 
     argv = ["autopilot", "--episodes", "2", "--episode-time", "2", "--out", str(tmp_path)]
     assert collect.main([*argv, "--no-progress"]) == 0
@@ -310,7 +316,7 @@ def test_trim_keys_move_the_neutral_the_surface_stays_on(tmp_path):
 
 
 def test_the_help_names_the_trim_keys():
-    from gymfg_il.collectors.manual_keys import help_lines
+    from gymfg_il.cockpit.inputs.keys import help_lines
     from gymfg_il.manual.bindings import KeyboardBindings
 
     text = "\n".join(help_lines("keyboard", KeyboardBindings()))
@@ -387,15 +393,18 @@ def test_a_slow_loop_counts_its_late_frames_and_the_window_warns(tmp_path):
 
     seen = []
 
+    def late_warning(session):
+        return session.stages.log.late_warning(session.stages.phases.state == "recording")
+
     def on_frame(frame, session):
         if frame == 1:
             key(pygame.K_SPACE)
         if frame in range(20, 26):
             time.sleep(0.1)  # 3 periods at 30 Hz: late by any measure
         if frame == 27:
-            seen.append(session.late_warning)
+            seen.append(late_warning(session))
         if frame == 95:  # the episode (90 frames from frame 1) has ended
-            seen.append(session.late_warning)
+            seen.append(late_warning(session))
             key(pygame.K_q)
 
     session = ManualSession(manual_config(tmp_path), on_frame, realtime=True)
@@ -403,7 +412,7 @@ def test_a_slow_loop_counts_its_late_frames_and_the_window_warns(tmp_path):
     assert seen[0].startswith("LATE: ") and seen[1] == ""  # warned while flying, not after
     eps = load_frames(tmp_path / "dataset").episodes
     late = eps["gymfg/late_frames"][0]
-    assert 6 <= late == session.timing.late  # a busy machine may make more late
+    assert 6 <= late == session.stages.log.timing.late  # a busy machine may make more late
     # 6 frames of 133 ms among 90 of 33 ms: at most 27 Hz, the spread tens of ms
     assert 5 < eps["gymfg/rate_hz"][0] < 27.5 and eps["gymfg/jitter_ms"][0] > 10
     card = (tmp_path / "dataset" / "README.md").read_text()

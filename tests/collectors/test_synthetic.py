@@ -11,9 +11,8 @@ import pytest
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 
 from gymfg_il import collect
+from gymfg_il.cockpit.session import ManualSession
 from gymfg_il.collectors.config import ManualConfig
-from gymfg_il.collectors.manual import ManualSession
-from gymfg_il.collectors.synthetic import SyntheticDriver
 from gymfg_il.learning.data import load_frames
 from gymfg_il.manual.controller import ManualController
 from gymfg_il.manual.synthetic import Skill
@@ -22,26 +21,26 @@ from gymfg_il.manual.synthetic import Skill
 def fly(tmp_path, device, skill=0.5):
     flight = {"task": "altitude", "episode_time_s": 8, "agent_hz": 30}
     pilot = {"pilot": "synthetic", "device": device}
-    cfg = ManualConfig(**flight, **pilot, episodes=1, seed=11, out=tmp_path)
-    driver = SyntheticDriver(skill)
-    ManualSession(cfg, driver).run()
-    return driver, load_frames(tmp_path / "dataset")
+    cfg = ManualConfig(**flight, **pilot, skill=skill, episodes=1, seed=11, out=tmp_path)
+    session = ManualSession(cfg)
+    session.run()
+    return session.stages.input, load_frames(tmp_path / "dataset")
 
 
 @pytest.mark.parametrize("device", ["keyboard", "joystick", "mouse"])
 def test_what_the_pilot_pressed_is_what_the_dataset_shows(tmp_path, device):
-    driver, frames = fly(tmp_path, device)
+    pilot, frames = fly(tmp_path, device)
     assert len(frames) == 240 and frames.episodes["gymfg/source"] == ["synthetic"]
     # a fresh controller fed the pilot's own events gives the dataset's actions exactly
     ref = ManualController(device, throttle=0.75)
     ref.start_from(frames.action[0].astype(np.float64))  # the trimmed start's controls
     expected = [ref.values.copy()]  # the first step flies them
-    for events in driver.sent:
+    for events in pilot.sent:
         ref.handle(events, 1 / 30)
         expected.append(ref.values.copy())
     assert len(expected) == len(frames)
     assert np.allclose(np.array(expected), frames.action, atol=1e-6)
-    made = [e for frame in driver.sent for e in frame]
+    made = [e for frame in pilot.sent for e in frame]
     assert made, "the pilot did nothing"
     if device == "keyboard":  # keys go down and up again: taps, not a held stick
         downs = sum(e.type == pygame.KEYDOWN for e in made)
@@ -96,8 +95,9 @@ def test_the_pilot_who_sees_only_the_window_flies_each_maneuver(tmp_path, task, 
     cfg = ManualConfig(**flight, pilot="synthetic", skill=skill, episodes=1)
     session = ManualSession(cfg)
     session.run()
-    assert session.debrief is not None
-    assert session.debrief.success, session.debrief.lines
+    said = session.stages.log.debrief
+    assert said is not None
+    assert said.success, said.lines
     # the verdict is stored with the episode, the pilot named by its skill
     episodes = load_frames(tmp_path / "dataset").episodes
     assert episodes["gymfg/success"] == [1] and episodes["gymfg/pilot"] == ["synthetic-0.7"]

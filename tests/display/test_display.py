@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
+from gymfg_il.cockpit.windows.gui import ControlsGUI, GuiFrame, spoken
 from gymfg_il.display.briefing import briefing, debrief
 from gymfg_il.display.guidance import reading_names
 from gymfg_il.display.readings import PRIMARY, display_of
-from gymfg_il.manual.gui import ControlsGUI, GuiFrame, spoken
 from gymfg_il.manual.perception import MOTION, DisplayIntent
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.tasks.library import TASK_FAMILIES
@@ -120,7 +120,7 @@ def test_every_library_task_is_checked_here():
 
 
 def test_the_next_gate_is_highlighted_in_the_view(make_env):
-    from gymfg_il.collectors.manual_view import next_gate_marked
+    from gymfg_il.cockpit.windows.pygame_window import next_gate_marked
     from gymfg_il.tasks.scenery import landmarks_of
 
     env, display = started(make_env, "waypoints")

@@ -250,8 +250,8 @@ def test_a_manual_session_records_what_flightgear_commands(sky, tmp_path):
     """Keys and FlightGear's stick follow what the session has heard, not fixed frames: a
     busy machine's FlightGear sends a packet every 0.2-0.4 s, and the session starting an
     episode (its dataset helper's imports) can stall it for longer."""
+    from gymfg_il.cockpit.session import ManualSession
     from gymfg_il.collectors.config import ManualConfig
-    from gymfg_il.collectors.manual import ManualSession
     from gymfg_il.learning.data import load_frames
 
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
@@ -261,7 +261,7 @@ def test_a_manual_session_records_what_flightgear_commands(sky, tmp_path):
         pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=k, mod=0, unicode="", scancode=0))
 
     def rudder_heard(session, value):
-        latest = session.human.cockpit.latest
+        latest = session.stages.human.cockpit.latest
         return latest is not None and latest[2] == pytest.approx(value)
 
     at = {}  # frame -> what happened at its start (the step of frame f is row f - 1)

@@ -17,18 +17,15 @@ NEEDED = [tool for tool in ("Xvfb", "import") if shutil.which(tool) is None]
 FLY = """
 import subprocess, sys
 from pathlib import Path
+from gymfg_il.cockpit.session import ManualSession
 from gymfg_il.collectors.config import ManualConfig
-from gymfg_il.collectors.manual import ManualSession
-from gymfg_il.collectors.synthetic import SyntheticDriver
 
 out = Path(sys.argv[1])
 for task in sys.argv[2:]:
-    pilot = SyntheticDriver()
 
-    def on_frame(frame, session, task=task, pilot=pilot):
+    def on_frame(frame, session, task=task):
         if frame == 60:  # two seconds in: what X shows, not what pygame holds
             subprocess.run(["import", "-window", "root", str(out / f"{task}.png")], check=True)
-        pilot(frame, session)
 
     cfg = ManualConfig(task=task, agent_hz=30, pilot="synthetic", episodes=1, seed=4,
                        out=out / task)

@@ -1,0 +1,45 @@
+"""The first stage of each frame: pace the loop to the wall clock at the flight's rate (a
+person's session), or not at all (the synthetic pilot flies as fast as the machine allows),
+and say how long the loop period that led to this frame was (``cockpit.timing`` counts the
+late ones)."""
+
+from __future__ import annotations
+
+import time
+
+
+class Pace:
+    """Frames ``period_s`` apart on the wall clock when ``realtime``; each ``wait`` returns at
+    the start of a frame with the loop period that led to it (None for the first frame).
+
+    A loop that falls more than a period behind starts again from now instead of bursting
+    to catch up (the simulation slows; ``cockpit.timing`` says so)."""
+
+    def __init__(self, period_s: float, realtime: bool) -> None:
+        self.period_s, self.realtime = period_s, realtime
+        self._deadline: float | None = None
+        self._last_start: float | None = None
+
+    def wait(self) -> float | None:
+        """Wait for the next frame's start (real time only); the loop period since the last."""
+        if self._deadline is None:
+            self._deadline = time.perf_counter()
+        elif self.realtime:
+            self._deadline += self.period_s
+            now = time.perf_counter()
+            if self._deadline < now - self.period_s:  # far behind: no catch-up burst
+                self._deadline = now
+            sleep_until(self._deadline)
+        start = time.perf_counter()
+        period = None if self._last_start is None else start - self._last_start
+        self._last_start = start
+        return period
+
+
+def sleep_until(deadline: float) -> None:
+    """Sleep coarsely, then spin the last millisecond (sleep alone overshoots by ~0.1-1 ms)."""
+    remaining = deadline - time.perf_counter()
+    if remaining > 0.0015:
+        time.sleep(remaining - 0.001)
+    while time.perf_counter() < deadline:
+        pass
