@@ -92,7 +92,7 @@ def _grades(grades: list[Any]) -> str:
 
 
 def _timing(episodes: dict[str, list[Any]], shown: int = 20) -> str:
-    """The rate and jitter of each episode flown in real time (``collectors.timing``)."""
+    """The rate and jitter of each episode flown in real time (``cockpit.timing``)."""
     late = [as_int(n) for n in episodes.get("gymfg/late_frames", [])]
     rate = [as_float(r) for r in episodes.get("gymfg/rate_hz", [-1.0] * len(late))]
     jitter = [as_float(j) for j in episodes.get("gymfg/jitter_ms", [-1.0] * len(late))]

@@ -92,7 +92,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
 
 
 def _timing(end: dict[str, Any]) -> dict[str, Any]:
-    """A real-time episode's timing (``collectors.timing``): late frames, rate and jitter,
+    """A real-time episode's timing (``cockpit.timing``): late frames, rate and jitter,
     each -1 where the session ran as fast as it could or the log holds none."""
     late = end.get("late_frames")
     out: dict[str, Any] = {"late_frames": late if type(late) is int and late >= 0 else -1}

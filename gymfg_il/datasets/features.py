@@ -11,7 +11,7 @@
 | intervention | bool | (1,) | a human flew this step (human takeover / DAgger) |
 | wall_time | float32 | (1,) | wall-clock s from the episode's first frame to this frame's input |
 | | | | (beside ``timestamp``, the simulation's): only in a dataset made from logs with frames |
-| | | | flown in real time (``collectors.timing``); -1 in frames flown faster. The episode's |
+| | | | flown in real time (``cockpit.timing``); -1 in frames flown faster. The episode's |
 | | | | ``gymfg/wall_start`` is its first frame's wall clock (Unix s) |
 | observation.images.<view> | video | (H, W, 3) | camera frames, only with ``images`` |
 
