@@ -30,6 +30,7 @@ def test_the_online_benchmark_keeps_the_clients_waits_to_itself():
     assert "waiting for" not in done.stderr, done.stderr
 
 
+@pytest.mark.slow
 def test_the_rl_benchmark_prints_the_sampling_beside_its_ceiling():
     done = _benchmark("rl", "--quick", "--envs", "2")
     assert done.returncode == 0, done.stderr[-2000:]

@@ -10,6 +10,7 @@ from gymfg_il import demo
 ROOT = Path(__file__).resolve().parents[1]
 
 
+@pytest.mark.slow
 def test_main_job_runs_the_whole_loop_and_writes_a_report(tmp_path, capsys):
     code = demo.main(
         [

@@ -49,6 +49,7 @@ def site(tmp_path_factory):
     return site
 
 
+@pytest.mark.slow
 def test_the_site_builds_strictly_with_a_page_per_module_and_command(site):
     spec = importlib.util.spec_from_file_location("walk", ROOT / "docs/generate/package_walk.py")
     walk = importlib.util.module_from_spec(spec)

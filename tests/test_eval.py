@@ -80,6 +80,7 @@ def test_help_explains_every_option():
     assert "Figure 1" in out
 
 
+@pytest.mark.slow
 def test_a_policy_flies_at_its_own_rate_and_the_rows_say_so(tmp_path, capsys):
     from gymfg_il.collectors.autopilot import collect_autopilot
     from gymfg_il.collectors.config import CollectConfig

@@ -5,6 +5,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 ENV = {**os.environ, "HF_HUB_OFFLINE": "1", "SDL_VIDEODRIVER": "dummy"}
 
 
@@ -16,6 +18,7 @@ def run(*argv: str) -> subprocess.CompletedProcess[str]:
     return done
 
 
+@pytest.mark.slow
 def test_a_manual_run_prints_no_pkg_resources_warning(tmp_path):
     argv = ["manual", "--pilot", "synthetic", "--device", "keyboard", "--episodes", "1"]
     argv += ["--episode-time", "2", "--out", str(tmp_path / "run"), "--no-progress"]

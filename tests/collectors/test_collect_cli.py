@@ -17,6 +17,7 @@ from gymfg_il.errors import ConfigError
 ENV = {**os.environ, "HF_HUB_OFFLINE": "1", "PYTHONUNBUFFERED": "1"}
 
 
+@pytest.mark.slow
 def test_recipe_runs_and_options_override(tmp_path, capsys):
     recipe = tmp_path / "r.toml"
     recipe.write_text(
@@ -83,6 +84,7 @@ def test_corrupt_log_is_a_clear_error(tmp_path, capsys):
     assert "not a readable GymFG trajectory log" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_sigkill_at_random_moments_loses_no_completed_episode(tmp_path):
     """Kill real collector processes at random moments; recover must keep every episode the
     collector reported as saved (it reports only after the episode is durable)."""

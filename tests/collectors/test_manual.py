@@ -45,6 +45,7 @@ def run(out, script, **kwargs):
     return session.run(max_frames=400)
 
 
+@pytest.mark.slow
 def test_keyboard_rates_and_centring_reach_the_dataset(tmp_path):
     script = {
         1: [lambda: key(pygame.K_SPACE)],
@@ -77,6 +78,7 @@ def test_keyboard_rates_and_centring_reach_the_dataset(tmp_path):
     assert frames.episodes["gymfg/source"] == ["human"]
 
 
+@pytest.mark.slow
 def test_mouse_is_the_stick(tmp_path):
     move = pygame.event.Event(
         pygame.MOUSEMOTION, pos=(625 + 100, 350 - 50), rel=(0, 0), buttons=(0, 0, 0)
@@ -93,6 +95,7 @@ def test_mouse_is_the_stick(tmp_path):
     assert frames.action[2, 0] == trim[0] and trim[1] > 0.1  # the c172p's trimmed elevator
 
 
+@pytest.mark.slow
 def test_joystick_axes_buttons_and_unplugging(tmp_path):
     added = pygame.event.Event(pygame.JOYDEVICEADDED, device_index=0, instance_id=0)
     axis = pygame.event.Event(pygame.JOYAXISMOTION, instance_id=0, axis=0, value=0.6)
@@ -121,6 +124,7 @@ def test_joystick_axes_buttons_and_unplugging(tmp_path):
     assert len(a) == 59  # the button ended and saved the episode
 
 
+@pytest.mark.slow
 def test_takeover_from_the_controller_is_flagged_and_handed_back(tmp_path):
     script = {
         1: [lambda: key(pygame.K_SPACE)],
@@ -145,6 +149,7 @@ def test_takeover_from_the_controller_is_flagged_and_handed_back(tmp_path):
     assert abs(frames.action[39, 1] - frames.action[38, 1]) < 0.1
 
 
+@pytest.mark.slow
 def test_discarded_episode_is_flown_again_with_its_seed(tmp_path):
     script = {
         1: [lambda: key(pygame.K_SPACE)],
@@ -158,6 +163,7 @@ def test_discarded_episode_is_flown_again_with_its_seed(tmp_path):
     assert frames.episodes["gymfg/seed"] == [7] and len(frames) == 90
 
 
+@pytest.mark.slow
 def test_appending_another_task_is_refused(tmp_path):
     run(tmp_path, {1: [lambda: key(pygame.K_SPACE)], 200: [lambda: key(pygame.K_q)]})
     with pytest.raises(ConfigError, match="features differ"):
@@ -190,6 +196,7 @@ def test_the_gui_shows_the_tasks_target_while_flying(tmp_path):
     assert any("Success" in line for line in idle[0].notes)  # the briefing, before it
 
 
+@pytest.mark.slow
 def test_the_window_says_how_an_episode_went(tmp_path):
     def on_frame(frame, session):
         if frame == 1:
@@ -250,6 +257,7 @@ def test_a_policy_assists_only_at_the_rate_it_was_trained_at(tmp_path):
         ManualSession(manual_config(tmp_path / "out", assist=str(policy)), driven, realtime=False)
 
 
+@pytest.mark.slow
 def test_the_dataset_helper_builds_on_request_and_outlives_a_crash(tmp_path, caplog):
     from gymfg_il import collect
     from gymfg_il.cockpit.updater import DatasetUpdater
@@ -289,6 +297,7 @@ def test_a_trimmed_stick_keeps_its_full_travel():
     assert deflect(0.18, 0.5) == pytest.approx(0.59) and deflect(0.18, -0.5) == -0.41
 
 
+@pytest.mark.slow
 def test_trim_keys_move_the_neutral_the_surface_stays_on(tmp_path):
     script = {
         1: [lambda: key(pygame.K_SPACE)],
@@ -324,6 +333,7 @@ def test_the_help_names_the_trim_keys():
     assert "TRIM" not in "\n".join(help_lines("joystick", KeyboardBindings()))
 
 
+@pytest.mark.slow
 def test_verdicts_marks_and_the_pilot_reach_the_dataset_and_its_card(tmp_path):
     script = {
         1: [lambda: key(pygame.K_SPACE)],
@@ -348,6 +358,7 @@ def test_verdicts_marks_and_the_pilot_reach_the_dataset_and_its_card(tmp_path):
     assert "success (1 episode)" in card
 
 
+@pytest.mark.slow
 def test_a_mark_needs_an_ended_episode(tmp_path):
     # before any episode, and while one is flown, G and B mark nothing
     script = {
@@ -361,6 +372,7 @@ def test_a_mark_needs_an_ended_episode(tmp_path):
     assert eps["gymfg/mark"] == [""] and eps["gymfg/pilot"] == [""]
 
 
+@pytest.mark.slow
 def test_train_selects_episodes_by_pilot_mark_and_verdict(tmp_path):
     from gymfg_il.learning.config import TrainConfig
     from gymfg_il.learning.selection import selected
@@ -386,6 +398,7 @@ def test_train_selects_episodes_by_pilot_mark_and_verdict(tmp_path):
         TrainConfig(select=["mark=good"])
 
 
+@pytest.mark.slow
 def test_a_slow_loop_counts_its_late_frames_and_the_window_warns(tmp_path):
     """In real time, frames made late by a slow loop are counted (the episode is kept), the
     window warns while it happens, and the dataset and card give the rate and jitter."""
@@ -439,6 +452,7 @@ def frame_columns(root, *names):
     return [np.array([float(f[n]) for f in frames]) for n in names]
 
 
+@pytest.mark.slow
 def test_a_session_run_as_fast_as_it_can_records_no_timing(tmp_path):
     run(tmp_path, {1: [lambda: key(pygame.K_SPACE)], 100: [lambda: key(pygame.K_q)]})
     eps = load_frames(tmp_path / "dataset").episodes

@@ -52,6 +52,7 @@ def test_no_joystick_says_so_and_exits(tmp_path):
     assert "SDL_VIDEODRIVER=dummy draws the window nowhere" in err
 
 
+@pytest.mark.slow
 def test_a_person_is_refused_the_dummy_window_but_the_synthetic_pilot_flies_there(tmp_path):
     err = collect_manual(tmp_path, {"SDL_VIDEODRIVER": "dummy"}, "--device", "keyboard")
     assert "error: collect manual: SDL_VIDEODRIVER=dummy draws the window nowhere" in err

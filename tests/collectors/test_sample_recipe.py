@@ -5,6 +5,7 @@ import json
 from pathlib import Path
 
 import pyarrow.parquet as pq
+import pytest
 
 from gymfg_il import collect
 from gymfg_il.collectors.config import CollectConfig
@@ -54,6 +55,7 @@ def test_the_recipe_writes_a_fresh_folder_beside_the_bundled_one():
     assert out.parent == Path("datasets") and out.name != SAMPLE.name
 
 
+@pytest.mark.slow
 def test_the_recipe_remakes_the_bundled_sample_exactly(tmp_path):
     root = remade(tmp_path / "sample")
     assert json.loads((root / "meta/info.json").read_text())["total_episodes"] == 20

@@ -27,6 +27,7 @@ def fly(tmp_path, device, skill=0.5):
     return session.stages.input, load_frames(tmp_path / "dataset")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("device", ["keyboard", "joystick", "mouse"])
 def test_what_the_pilot_pressed_is_what_the_dataset_shows(tmp_path, device):
     pilot, frames = fly(tmp_path, device)
@@ -56,6 +57,7 @@ def test_a_novice_is_late_and_lapses_an_ace_less_so():
         Skill.of(1.5)
 
 
+@pytest.mark.slow
 def test_collect_manual_with_the_synthetic_pilot_runs_headless(tmp_path, capsys):
     flight = ["--task", "roll", "--episode-time", "5"]
     pilot = ["--pilot", "synthetic", "--device", "keyboard"]
@@ -84,6 +86,7 @@ def test_eval_scores_the_synthetic_pilot_beside_the_controller(tmp_path):
     assert 0.8 < pilot["return_ratio"] < 1.05
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("task", "skill"),
     # at the default skill (docs/results/cockpit.md: 15 and 16 of 16 held-out formations)

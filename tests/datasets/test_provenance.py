@@ -19,6 +19,7 @@ def sessions(tmp_path_factory):
     return tmp
 
 
+@pytest.mark.slow
 def test_split_episodes_get_their_own_metadata_back(sessions, capsys):
     from lerobot.datasets.dataset_tools import split_dataset
 

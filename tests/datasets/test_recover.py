@@ -161,6 +161,7 @@ def test_a_dataset_that_holds_an_episode_twice_is_rebuilt(copy, capsys):
     assert "the same episode as dataset episode 0" in out
 
 
+@pytest.mark.slow
 def test_unreadable_logs_are_set_aside_and_the_rest_rebuilt(copy, tmp_path):
     """#32.12: 4,000 random bytes, a FIFO and a symlink to /dev/zero beside a good log
     stopped the whole folder (exit 2, or a hang); each is set aside, named, and the rest

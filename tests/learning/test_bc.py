@@ -46,6 +46,7 @@ def test_training_is_reproducible_with_a_seed(trained, tiny_dataset, tmp_path):
     ).read_bytes()
 
 
+@pytest.mark.slow
 def test_policy_flies_better_than_a_zero_action_agent(trained, far_target_seeds):
     env = AircraftEnv("altitude", "c172p", episode_time_s=60)
     policy = PolicyAgent.load(trained.out)

@@ -72,6 +72,7 @@ def test_temporal_ensembling_weights_newer_chunks_by_the_decay():
     assert torch.allclose(action[0], expected, atol=1e-6)
 
 
+@pytest.mark.slow
 def test_chunk_policy_trains_and_flies(tiny_dataset, tmp_path, far_target_seeds):
     result = train_bc(
         TrainConfig(

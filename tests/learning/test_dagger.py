@@ -1,6 +1,7 @@
 """DAgger improves on plain BC trained from too few demonstrations."""
 
 import numpy as np
+import pytest
 
 from gymfg_il.collectors.autopilot import record_autopilot
 from gymfg_il.collectors.config import CollectConfig
@@ -13,6 +14,7 @@ from gymfg_il.learning.data import load_frames
 from gymfg_il.rollout import AgentSpec, fly_many
 
 
+@pytest.mark.slow
 def test_dagger_beats_plain_bc(tmp_path):
     # two clean demonstrations: BC never sees how to recover from its own deviations
     demo = CollectConfig(
@@ -79,6 +81,7 @@ def test_dagger_flies_the_policys_own_flight(tmp_path):
     assert FlightSpec.from_dict(retrained["spec"]) == demo.flight()
 
 
+@pytest.mark.slow
 def test_recover_rebuilds_every_episode_of_a_dagger_session_and_names_what_it_cannot(
     tmp_path, capsys
 ):

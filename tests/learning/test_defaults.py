@@ -18,6 +18,7 @@ from gymfg_il.learning.config import TrainConfig
 
 # altitude needs the 40 demonstrations: from 20, its policy holds the 50-ft tolerance
 # in 14 of 16 held-out episodes (a steady offset, no crash)
+@pytest.mark.slow
 @pytest.mark.parametrize(("task", "demonstrations"), [("roll", 20), ("altitude", 40)])
 def test_clean_demonstrations_with_default_settings_give_a_policy_that_does_not_crash(
     task, demonstrations, tmp_path

@@ -434,6 +434,7 @@ def old_policy(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "where, survivor",
     [
@@ -559,7 +560,9 @@ def test_flying_a_policy_that_names_a_task_that_cannot_fly_is_one_line(
     out = str(tmp_path / "out")
     code = {
         "eval": lambda: evaluate.main(["--policy", policy, "--episodes", "1", "--no-progress"]),
-        "ppo --init": lambda: train.main(["ppo", "--init", policy, "--steps", "64", "--out", out]),
+        "ppo --init": lambda: train.main(
+            ["ppo", "--init", policy, "--steps", "8192", "--out", out, "--no-progress"]
+        ),
         "collect dagger": lambda: collect.main(
             ["dagger", "--policy", policy, "--out", out, "--iterations", "1", "--episodes", "1"]
         ),

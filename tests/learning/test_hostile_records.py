@@ -99,6 +99,7 @@ def test_a_shift_of_other_digits_is_refused(tmp_path, capsys, shift):
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_a_dataset_merged_with_itself_trains_each_episode_once(tmp_path, caplog):
     """#52.6: LeRobot's merge of a dataset with itself trained on every episode twice with no
     word; now each is trained once and the warning names the repeats."""

@@ -51,6 +51,7 @@ def test_batches_stack_each_frame_with_the_one_before_inside_its_episode(roll_im
         assert torch.equal(batches.images[batches.index["images"][i]], want), k
 
 
+@pytest.mark.slow
 def test_a_vision_policy_trains_and_flies_by_the_envs_camera(roll_images, tmp_path):
     cfg = TrainConfig(
         dataset=roll_images, out=tmp_path, policy=VisionConfig(hidden=[64]), epochs=3, threads=2

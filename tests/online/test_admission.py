@@ -50,6 +50,7 @@ BAD_NAMES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("where", ["team", "callsign", "aircraft model"])
 @pytest.mark.parametrize("bad", sorted(BAD_NAMES))
 def test_names_on_the_wire_are_printable_and_short(serve, where, bad, zmq_ctx):
@@ -230,6 +231,7 @@ SQUATS = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(SQUATS))
 def test_a_team_holds_its_name_and_callsigns_only_while_it_reports(serve, case, zmq_ctx):
     options, (team, token, callsigns), refused = SQUATS[case]

@@ -21,6 +21,7 @@ import run_team  # noqa: E402
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck))
 @given(
     payload=st.one_of(

@@ -66,6 +66,7 @@ def test_the_k_plus_first_team_is_refused(server):
     second.close()
 
 
+@pytest.mark.slow
 def test_a_killed_client_neither_hangs_nor_crashes_the_others_and_can_rejoin(server, tmp_path):
     address, srv = server(
         "--mode", "fixed", "--teams", "2", "--secret", "s", "--timeout", "1", "--on-stall", "drop"

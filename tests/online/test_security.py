@@ -84,6 +84,7 @@ def test_a_server_without_secrets_says_so_and_stays_on_loopback(serve):
     assert address.startswith("tcp://0.0.0.0:")
 
 
+@pytest.mark.slow
 def test_fixed_slots_are_freed_and_every_simulation_takes_new_teams(serve, zmq_ctx):
     # the squatters hold their slots for the 4 s timeout: long enough for the third's join
     # to find them held on a busy machine (1 s failed in CI)
@@ -108,6 +109,7 @@ def test_fixed_slots_are_freed_and_every_simulation_takes_new_teams(serve, zmq_c
         sock.close(0)
 
 
+@pytest.mark.slow
 def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve, zmq_ctx):
     address, proc, err = serve("--mode", "open", "--max-teams", "8", "--timeout", "2")
 
@@ -139,6 +141,7 @@ def test_a_join_flood_is_bounded_and_its_refusals_summarised(serve, zmq_ctx):
     sock.close(0)
 
 
+@pytest.mark.slow
 def test_a_team_waiting_for_the_others_hears_why_instead_of_timing_out(serve, caplog):
     import logging
 

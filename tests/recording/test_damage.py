@@ -169,6 +169,7 @@ def test_reindex_refuses_a_damaged_log_it_used_to_call_fine(session, tmp_path, c
         assert target.read_bytes() == bytes(bad)  # left as it was
 
 
+@pytest.mark.slow
 def test_no_single_flipped_byte_outside_the_chunks_loses_the_whole_log(session, tmp_path):
     """Red team #32.9: the bytes before the first chunk's records (the magic, the header, the
     session record and its copy, the channel table), the first chunk's record header, and the

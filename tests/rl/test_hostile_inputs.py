@@ -181,6 +181,7 @@ def _kill_when_scratched(argv, tmp):
     return _scratch(tmp)
 
 
+@pytest.mark.slow
 def test_a_killed_runs_scratch_folder_is_cleared_by_the_next_run(bc_policy, tmp_path, monkeypatch):
     from gymfg_il.rl.run import train_ppo
 

@@ -71,6 +71,7 @@ def _bounds(env):
     return env.action_space.low, env.action_space.high
 
 
+@pytest.mark.slow
 def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     from safetensors.torch import load_file
 
@@ -123,6 +124,7 @@ def test_a_short_fine_tune_saves_a_policy_that_eval_flies(bc_policy, tmp_path):
     assert any("different weather" in n and "as asked" in n for n in run.notes)
 
 
+@pytest.mark.slow
 def test_a_seeded_run_repeats(bc_policy, tmp_path):
     from safetensors.torch import load_file
 
@@ -169,6 +171,7 @@ def _flight(bc_policy):
     return starting_policy(PPORunConfig(init=bc_policy)).flight
 
 
+@pytest.mark.slow
 def test_the_critic_warms_up_before_the_actor_moves(bc_policy, tmp_path):
     from stable_baselines3.common.vec_env import DummyVecEnv
 
@@ -274,6 +277,7 @@ def test_train_bc_does_not_offer_ppo():
     assert p.parse_args(["ppo", "--init", "x"]).algorithm == "ppo"
 
 
+@pytest.mark.slow
 def test_the_success_bonus_follows_the_verdict_eval_gives(bc_policy):
     from gymfg_il.evaluation.runner import evaluate
     from gymfg_il.rl.envs import make_env

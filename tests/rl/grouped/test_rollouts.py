@@ -84,6 +84,7 @@ def test_the_grouped_sampler_fills_the_buffer_stable_baselines3s_own_loop_fills(
     assert np.allclose(own.env.ret_rms.var, grouped.env.ret_rms.var, rtol=1e-4)
 
 
+@pytest.mark.slow
 def test_every_rollout_samples_the_policy_as_it_is_now(tmp_path):
     model, callback = _model(4, tmp_path, episode_time_s=90.0)
     try:

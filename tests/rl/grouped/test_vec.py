@@ -44,6 +44,7 @@ def _run(venv, actions):
     return out, ends
 
 
+@pytest.mark.slow
 def test_a_grouped_run_repeats_subprocesses_bit_for_bit():
     # 3 s episodes at 10 Hz: the 80 steps cross two auto-resets in every env
     flight = FlightSpec.solo("c172p", "altitude", episode_time_s=3.0)
@@ -63,6 +64,7 @@ def test_a_grouped_run_repeats_subprocesses_bit_for_bit():
     assert not np.array_equal(grouped[0][0], grouped[0][1])
 
 
+@pytest.mark.slow
 def test_attributes_and_methods_reach_the_right_envs():
     flight = FlightSpec.solo("c172p", "altitude", episode_time_s=3.0)
     fn = partial(make_env, flight.to_dict(), [0.0] * 4, [1.0] * 4)
