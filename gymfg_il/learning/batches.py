@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.learning.data import Frames
+from gymfg_il.learning.frames import Frames
 from gymfg_il.policies.window import Window, pool_frames
 
 

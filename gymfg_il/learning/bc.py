@@ -21,8 +21,8 @@ from gymfg_il.learning.config import TrainConfig, epochs_for, resolve_device
 
 if TYPE_CHECKING:
     from gymfg_il.envs.flight import FlightSpec
-    from gymfg_il.learning.data import Frames
     from gymfg_il.learning.fit import Estimate
+    from gymfg_il.learning.frames import Frames
     from gymfg_il.policies.window import Window
 
 # validation over training loss above which train says the policy memorised its

@@ -21,7 +21,7 @@ from gymfg_il.datasets.health import file_problems, stats_problems
 from gymfg_il.errors import ConfigError, GymFGError, join_problems
 
 if TYPE_CHECKING:
-    from gymfg_il.learning.data import Frames
+    from gymfg_il.learning.frames import Frames
 
 FEATURES = ("observation.state", "action")
 SHOWN = 5  # damaged frames named per column

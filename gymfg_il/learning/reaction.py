@@ -28,7 +28,7 @@ import numpy as np
 from gymfg_il.errors import ConfigError
 
 if TYPE_CHECKING:
-    from gymfg_il.learning.data import Frames
+    from gymfg_il.learning.frames import Frames
 
 log = logging.getLogger(__name__)
 

@@ -17,11 +17,11 @@ import numpy as np
 from gymfg_il.datasets.verify import digest
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.config import GRADE_WEIGHTS
-from gymfg_il.learning.data import episode_runs
+from gymfg_il.learning.frames import episode_runs
 from gymfg_il.tasks.grades import rank
 
 if TYPE_CHECKING:
-    from gymfg_il.learning.data import Frames
+    from gymfg_il.learning.frames import Frames
 
 log = logging.getLogger(__name__)
 

@@ -118,7 +118,7 @@ class Simulation:
         trim = None
         controls = (0.0, 0.0, 0.0, throttle)
         if ic.trimmed:
-            trim = trim_for(self.model, ic.altitude_ft, ic.airspeed_kts, self.sim_hz)
+            trim = trim_for(self.model, ic.altitude_ft, ic.airspeed_kts, self.sim_hz, Simulation)
             ic = dataclasses.replace(ic, pitch_deg=trim.pitch_deg, trimmed=False)
             controls = (trim.aileron, trim.elevator, trim.rudder, trim.throttle)
         self.trim = trim

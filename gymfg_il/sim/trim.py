@@ -15,14 +15,12 @@ the trim's controls with its throttle are hands-off flight.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
-
-if TYPE_CHECKING:
-    from gymfg_il.sim.simulation import Simulation
 
 ALTITUDE_STEP_FT = 1000.0
 AIRSPEED_STEP_KTS = 10.0
@@ -54,21 +52,32 @@ class Trim:
         return (self.pitch_deg, self.elevator, self.aileron, self.rudder, self.throttle)
 
 
+class Trimmer(Protocol):
+    """What trims: a JSBSim instance that resets to an untrimmed start (``Simulation``, which
+    passes itself as the maker: a reset needs a trim, and a trim a reset)."""
+
+    fdm: Any
+
+    def reset(self, ic: InitialConditions, throttle: float) -> Any: ...
+
+
+Maker = Callable[[str, int], Trimmer]  # (model, sim_hz) -> a new instance to trim in
+
 # a point JSBSim could not trim is remembered as its error: near the envelope's edge every
 # reset would otherwise try it again (~4 ms and a JSBSim message each time)
 _GRID: dict[tuple[str, int, float, float], Trim | ConfigError] = {}
-_TRIMMERS: dict[tuple[str, int], Simulation] = {}
+_TRIMMERS: dict[tuple[str, int], Trimmer] = {}
 
 
-def _trim_point(model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float) -> Trim:
+def _trim_point(
+    model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float, make: Maker
+) -> Trim:
     """JSBSim's full trim at one grid point, in this process's trimming instance."""
     import jsbsim
 
-    from gymfg_il.sim.simulation import Simulation
-
     sim = _TRIMMERS.get((model, sim_hz))
     if sim is None:
-        sim = _TRIMMERS[(model, sim_hz)] = Simulation(model, sim_hz)
+        sim = _TRIMMERS[(model, sim_hz)] = make(model, sim_hz)
     ic = InitialConditions(altitude_ft=altitude_ft, airspeed_kts=airspeed_kts, trimmed=False)
     sim.reset(ic, throttle=0.5)
     fdm = sim.fdm
@@ -89,12 +98,12 @@ def _trim_point(model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float
     )
 
 
-def _grid(model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float) -> Trim:
+def _grid(model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float, make: Maker) -> Trim:
     key = (model, sim_hz, altitude_ft, airspeed_kts)
     found = _GRID.get(key)
     if found is None:
         try:
-            found = _trim_point(model, sim_hz, altitude_ft, airspeed_kts)
+            found = _trim_point(model, sim_hz, altitude_ft, airspeed_kts, make)
         except ConfigError as err:
             found = err
         _GRID[key] = found
@@ -103,7 +112,7 @@ def _grid(model: str, sim_hz: int, altitude_ft: float, airspeed_kts: float) -> T
     return found
 
 
-def trim_for(model: str, altitude_ft: float, airspeed_kts: float, sim_hz: int) -> Trim:
+def trim_for(model: str, altitude_ft: float, airspeed_kts: float, sim_hz: int, make: Maker) -> Trim:
     """The trim of JSBSim ``model`` at ``altitude_ft`` and ``airspeed_kts`` (true airspeed),
     interpolated between the grid points around it (trimmed on first use). Near the edge of
     the aircraft's envelope, where a grid point around it cannot be trimmed, the point
@@ -113,12 +122,12 @@ def trim_for(model: str, altitude_ft: float, airspeed_kts: float, sim_hz: int) -
     wa, ws = a - i, s - j
     try:
         corners = [
-            _grid(model, sim_hz, ii * ALTITUDE_STEP_FT, jj * AIRSPEED_STEP_KTS)
+            _grid(model, sim_hz, ii * ALTITUDE_STEP_FT, jj * AIRSPEED_STEP_KTS, make)
             for ii in (i, i + 1)
             for jj in (j, j + 1)
         ]
     except ConfigError:
-        return _grid(model, sim_hz, altitude_ft, airspeed_kts)
+        return _grid(model, sim_hz, altitude_ft, airspeed_kts, make)
     low = corners[0].blend(corners[1], ws)
     high = corners[2].blend(corners[3], ws)
     return low.blend(high, wa)

@@ -74,11 +74,11 @@ def test_a_trimmed_start_is_straight_and_level():
 def test_trims_are_the_same_in_a_fresh_process():
     """A grid point trims alike whatever was trimmed before it: resets reproduce across
     worker processes."""
-    trim_for("c172p", 7000.0, 95.0, 120)  # other grid points first, here
-    here = trim_for("c172p", 5250.0, 104.0, 120)
+    trim_for("c172p", 7000.0, 95.0, 120, Simulation)  # other grid points first, here
+    here = trim_for("c172p", 5250.0, 104.0, 120, Simulation)
     code = (
-        "from gymfg_il.sim.trim import trim_for;"
-        "print(repr(trim_for('c172p', 5250.0, 104.0, 120).values()))"
+        "from gymfg_il.sim.simulation import Simulation; from gymfg_il.sim.trim import trim_for;"
+        "print(repr(trim_for('c172p', 5250.0, 104.0, 120, Simulation).values()))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == repr(here.values())
@@ -92,12 +92,12 @@ def test_low_starts_trim_without_a_grid_point_at_sea_level():
 
 def test_an_aircraft_that_cannot_be_trimmed_names_the_state():
     with pytest.raises(ConfigError, match=r"cannot trim c172p .* 9000 ft and 130 kt"):
-        trim_for("c172p", 9000.0, 130.0, 120)  # faster than its engine can hold level
+        trim_for("c172p", 9000.0, 130.0, 120, Simulation)  # faster than its engine can hold level
 
 
 def test_near_the_envelope_the_start_itself_is_trimmed():
     # 8,200 ft trims at 110 kt; the grid points above it (9,000 ft) do not
-    trim = trim_for("c172p", 8200.0, 110.0, 120)
+    trim = trim_for("c172p", 8200.0, 110.0, 120, Simulation)
     sim = Simulation("c172p")
     sim.reset(InitialConditions(altitude_ft=8200.0, airspeed_kts=110.0, trimmed=True), 0.75)
     assert sim.trim == trim
