@@ -167,13 +167,7 @@ def _build(
     logs, empty, unreadable = read_logs(log_paths)
     if not logs:
         raise no_logs(root, unreadable)
-    # a DAgger session's linked base logs: only the base episodes, first, in the base's order
-    base = [ref for _, ref in base_refs({p.parent for p in log_paths}) if ref is not None]
-    only: dict[str, set[tuple[int, str]]] = {}
-    for ref in base:
-        only.setdefault(ref.log, set()).add((ref.episode, ref.callsign))
-    rank = {name: i for i, name in enumerate(dict.fromkeys(ref.log for ref in base))}
-    logs.sort(key=lambda lg: (rank.get(lg.path.name, len(rank)), str(lg.path)))
+    only = _base_order(logs, log_paths)
     chosen = chosen_aircraft(logs, callsigns)
     first_log, first = chosen[0]
     info = first_log.aircraft(first)
@@ -181,21 +175,8 @@ def _build(
     size = int(first_log.session.get("image_size", DEFAULT_IMAGE_SIZE))
     cameras = {image_key(v): Camera(size, size, view=v) for v in views}
     fps = first_log.spec.agent_hz
-    label = info["task"].get("task", "task")
-    repo_id = repo_id or f"gymfg/{label}-{info['model']}"
-    # every episode the logs offer, in the order a build takes them
-    taken = {(lg.path, c) for lg, c in chosen}
-    offered: list[tuple[Log, LoggedEpisode, str, EpisodeRef]] = []
-    for lg in logs:
-        wanted = only.get(lg.path.name)
-        for episode in lg.complete_episodes:
-            for callsign in episode.steps:  # in the order the flight lists them
-                if (lg.path, callsign) in taken and (
-                    wanted is None or (episode.index, callsign) in wanted
-                ):
-                    offered.append(
-                        (lg, episode, callsign, EpisodeRef(lg.path.name, episode.index, callsign))
-                    )
+    repo_id = repo_id or f"gymfg/{info['task'].get('task', 'task')}-{info['model']}"
+    offered = _offered(logs, chosen, only)
     logged = {ref: episode_columns(ep, c) for _, ep, c, ref in offered}
     records = {ref: episode_metadata(lg, ep, c) for lg, ep, c, ref in offered}
     # frames flown in real time keep their wall time in a dataset made now (not in one
@@ -203,67 +184,161 @@ def _build(
     clock = any((columns[WALL_TIME] >= 0).any() for columns in logged.values())
     features = dataset_features(info["observation_names"], views, size, clock)
     work = root.with_name(f"{root.name}.building-{time.time_ns()}")
-    found: list[str] = []
-    refs: list[EpisodeRef | None] = []
-    digests: list[str] = []
-    aside = None
-    if root.exists():
-        checked, refs = _check(root, features, fps, logged, records)
-        found, digests = checked.problems, checked.digests
-        if found:
-            aside = root.with_name(f"{root.name}.broken-{time.strftime('%Y%m%d-%H%M%S')}")
-            root.rename(aside)
-            log.warning(
-                "the dataset at %s differs from its logs or cannot be read; kept it as "
-                "%s and rebuilt it: %s",
-                root,
-                aside,
-                "; ".join(found[:3]),
-            )
-            refs, digests = [], []
-        else:
-            shutil.copytree(root, work)
-            write_columns(work, {MARK: checked.marks})  # marks given after the build
+    old = _existing(root, work, features, fps, logged, records)
     outcomes = {lg.path.name: LogOutcome(lg.path.name, damaged=bool(lg.damage)) for lg in logs}
-    # an episode already held, or held by an earlier log: by its frames
-    holder: dict[str, EpisodeRef | int] = {}
-    for k, (held, d) in enumerate(zip(refs, digests, strict=True)):
-        holder.setdefault(d, k if held is None else held)
-    present = {held for held in refs if held is not None}
-    twins: dict[str, list[tuple[EpisodeRef, EpisodeRef | int]]] = {}
-    added = frames = 0
     try:
         builder = DatasetBuilder(work, repo_id, fps, features, robot_type=info["model"])
-        for lg, episode, callsign, ref in offered:
-            outcome = outcomes[lg.path.name]
-            if ref in present:
-                outcome.held.append(ref)
-                outcome.seeds.append(records[ref]["seed"])
-                continue
-            columns = logged[ref]
-            twin = holder.setdefault(digest(columns["observation.state"], columns["action"]), ref)
-            if twin != ref:
-                twins.setdefault(lg.path.name, []).append((ref, twin))
-                continue
-            pictures = {
-                key: episode_frames(lg, episode, callsign, camera)
-                for key, camera in cameras.items()
-            }
-            builder.add_episode(
-                columns,
-                lg.aircraft(callsign)["task_description"],
-                records[ref],
-                pictures,
-            )
-            outcome.added.append(ref)
-            outcome.seeds.append(records[ref]["seed"])
-            added += 1
-            frames += len(columns["action"])
+        added = _add(builder, offered, logged, records, old, outcomes, cameras)
         builder.finalize(card_root=root)
         total = builder.meta.total_episodes
     except BaseException:
         shutil.rmtree(work, ignore_errors=True)
         raise
+    _swap_in(work, root)
+    for name, pairs in added.twins.items():
+        outcomes[name].left_out += _twin_lines(pairs)
+    twins = added.twins.values()
+    skipped = sum(1 for lg in logs for e in lg.episodes if not e.complete and not e.discarded)
+    return BuildReport(
+        added.episodes,
+        added.frames,
+        skipped,
+        total,
+        time.perf_counter() - started,
+        old.aside is not None,
+        _damage(logs, unreadable),
+        empty,
+        set(logged),
+        list(outcomes.values()),
+        unreadable,
+        old.problems,
+        old.aside,
+        {t: ref for pairs in twins for ref, t in pairs if isinstance(t, int)},
+    )
+
+
+def _damage(logs: list[Log], unreadable: list[Unreadable]) -> list[str]:
+    """ "log: what was lost and why", for the logs read and those that could not be."""
+    damage = [f"{lg.path.name}: {note}" for lg in logs for note in lg.damage]
+    return damage + [f"{u.path.name}: not read: {u.why}" for u in unreadable]
+
+
+def _base_order(logs: list[Log], log_paths: Sequence[Path]) -> dict[str, set[tuple[int, str]]]:
+    """Put a DAgger session's linked base logs first, in the base dataset's order (``logs``
+    sorted in place); of each, the (episode, callsign) the base dataset took."""
+    base = [ref for _, ref in base_refs({p.parent for p in log_paths}) if ref is not None]
+    only: dict[str, set[tuple[int, str]]] = {}
+    for ref in base:
+        only.setdefault(ref.log, set()).add((ref.episode, ref.callsign))
+    rank = {name: i for i, name in enumerate(dict.fromkeys(ref.log for ref in base))}
+    logs.sort(key=lambda lg: (rank.get(lg.path.name, len(rank)), str(lg.path)))
+    return only
+
+
+def _offered(
+    logs: list[Log], chosen: list[tuple[Log, str]], only: dict[str, set[tuple[int, str]]]
+) -> list[tuple[Log, LoggedEpisode, str, EpisodeRef]]:
+    """Every episode the logs offer, in the order a build takes them."""
+    taken = {(lg.path, c) for lg, c in chosen}
+    offered = []
+    for lg in logs:
+        wanted = only.get(lg.path.name)
+        for episode in lg.complete_episodes:
+            for callsign in episode.steps:  # in the order the flight lists them
+                if (lg.path, callsign) in taken and (
+                    wanted is None or (episode.index, callsign) in wanted
+                ):
+                    ref = EpisodeRef(lg.path.name, episode.index, callsign)
+                    offered.append((lg, episode, callsign, ref))
+    return offered
+
+
+@dataclass
+class _Existing:
+    """What a build keeps of the dataset already at its root."""
+
+    refs: list[EpisodeRef | None] = field(default_factory=list)  # each episode's log episode
+    digests: list[str] = field(default_factory=list)  # each episode's frames
+    problems: list[str] = field(default_factory=list)  # why it was set aside
+    aside: Path | None = None  # where
+
+
+def _existing(
+    root: Path,
+    work: Path,
+    features: dict[str, Any],
+    fps: int,
+    logged: dict[EpisodeRef, dict[str, np.ndarray]],
+    records: dict[EpisodeRef, dict[str, Any]],
+) -> _Existing:
+    """Check the dataset at ``root`` against the logs: copy it to ``work`` to build on (with
+    the marks given since), or set it aside as ``<root>.broken-<time>`` to rebuild."""
+    if not root.exists():
+        return _Existing()
+    checked, refs = _check(root, features, fps, logged, records)
+    if checked.problems:
+        aside = root.with_name(f"{root.name}.broken-{time.strftime('%Y%m%d-%H%M%S')}")
+        root.rename(aside)
+        log.warning(
+            "the dataset at %s differs from its logs or cannot be read; kept it as %s and "
+            "rebuilt it: %s",
+            root,
+            aside,
+            "; ".join(checked.problems[:3]),
+        )
+        return _Existing(problems=checked.problems, aside=aside)
+    shutil.copytree(root, work)
+    write_columns(work, {MARK: checked.marks})  # marks given after the build
+    return _Existing(refs, checked.digests)
+
+
+@dataclass
+class _Added:
+    episodes: int = 0
+    frames: int = 0
+    # per log, its episodes left out as repeats of another's (a log episode or a dataset index)
+    twins: dict[str, list[tuple[EpisodeRef, EpisodeRef | int]]] = field(default_factory=dict)
+
+
+def _add(
+    builder: DatasetBuilder,
+    offered: list[tuple[Log, LoggedEpisode, str, EpisodeRef]],
+    logged: dict[EpisodeRef, dict[str, np.ndarray]],
+    records: dict[EpisodeRef, dict[str, Any]],
+    old: _Existing,
+    outcomes: dict[str, LogOutcome],
+    cameras: dict[str, Camera],
+) -> _Added:
+    """Add each offered episode the dataset does not hold yet (by its log episode, or by its
+    frames), saying in ``outcomes`` what became of each."""
+    holder: dict[str, EpisodeRef | int] = {}  # an episode held, or held by an earlier log
+    for k, (held, d) in enumerate(zip(old.refs, old.digests, strict=True)):
+        holder.setdefault(d, k if held is None else held)
+    present = {held for held in old.refs if held is not None}
+    added = _Added()
+    for lg, episode, callsign, ref in offered:
+        outcome = outcomes[lg.path.name]
+        columns = logged[ref]
+        if ref in present:
+            outcome.held.append(ref)
+        elif (
+            twin := holder.setdefault(digest(columns["observation.state"], columns["action"]), ref)
+        ) != ref:
+            added.twins.setdefault(lg.path.name, []).append((ref, twin))
+            continue
+        else:
+            pictures = {k: episode_frames(lg, episode, callsign, c) for k, c in cameras.items()}
+            task = lg.aircraft(callsign)["task_description"]
+            builder.add_episode(columns, task, records[ref], pictures)
+            outcome.added.append(ref)
+            added.episodes += 1
+            added.frames += len(columns["action"])
+        outcome.seeds.append(records[ref]["seed"])
+    return added
+
+
+def _swap_in(work: Path, root: Path) -> None:
+    """The built copy takes the dataset's place (the old one deleted only then)."""
     if root.exists():
         old = root.with_name(f"{root.name}.old-{time.time_ns()}")
         root.rename(old)
@@ -272,28 +347,6 @@ def _build(
     else:
         work.rename(root)
     _clean_leftovers(root)
-    for name, pairs in twins.items():
-        outcomes[name].left_out += _twin_lines(pairs)
-    matched = {t: ref for pairs in twins.values() for ref, t in pairs if isinstance(t, int)}
-    skipped = sum(1 for lg in logs for e in lg.episodes if not e.complete and not e.discarded)
-    damage = [f"{lg.path.name}: {note}" for lg in logs for note in lg.damage]
-    damage += [f"{u.path.name}: not read: {u.why}" for u in unreadable]
-    return BuildReport(
-        added,
-        frames,
-        skipped,
-        total,
-        time.perf_counter() - started,
-        aside is not None,
-        damage,
-        empty,
-        set(logged),
-        list(outcomes.values()),
-        unreadable,
-        found,
-        aside,
-        matched,
-    )
 
 
 def _twin_lines(pairs: list[tuple[EpisodeRef, EpisodeRef | int]]) -> list[str]:

@@ -138,6 +138,41 @@ class Checked:
     marks: dict[int, str] = field(default_factory=dict)
 
 
+def _bookkeeping(
+    frames: Mapping[str, np.ndarray], rows: np.ndarray, start: int, meta: Any
+) -> list[str]:
+    """LeRobot's columns of one episode's ``rows`` that are not as a build writes them."""
+    steps = np.arange(len(rows))
+    task = frames["task_index"][rows]
+    tasks = len(meta.tasks) if meta.tasks is not None else 0
+    book = {
+        "frame_index": np.array_equal(frames["frame_index"][rows], steps),
+        "index": np.array_equal(frames["index"][rows], start + steps),
+        "timestamp": np.array_equal(
+            frames["timestamp"][rows], (steps / float(meta.fps)).astype(np.float32)
+        ),
+        "task_index": bool((task == task[0]).all() and 0 <= task[0] < tasks),
+    }
+    return [f"its {k} column is not as written" for k, ok in book.items() if not ok]
+
+
+def _frame_problems(
+    frames: Mapping[str, np.ndarray],
+    rows: np.ndarray,
+    columns: Mapping[str, np.ndarray],
+    features: Mapping[str, Any],
+) -> list[str]:
+    """Each column of one episode's ``rows`` that is not what its log's ``columns`` give."""
+    problems = []
+    for key, want in _expected(columns, features).items():
+        have = frames[key][rows]
+        if have.shape != want.shape:
+            problems.append(f"{key} has shape {have.shape}, its log {want.shape}")
+        elif not np.array_equal(have, want, equal_nan=have.dtype.kind == "f"):
+            problems.append(f"{key} differs from its log at frame {_first_difference(have, want)}")
+    return problems
+
+
 def differences(
     root: Path,
     meta: Any,
@@ -161,8 +196,6 @@ def differences(
         frames["episode_index"][order], return_index=True, return_counts=True
     )
     where = {int(e): order[s : s + n] for e, s, n in zip(held, starts, counts, strict=True)}
-    tasks = len(meta.tasks) if meta.tasks is not None else 0
-    fps = float(meta.fps)
     digests: list[str] = []
     seen: dict[str, int] = {}
     for e in range(len(episodes)):
@@ -177,19 +210,7 @@ def differences(
         if len(rows) != n or int(row["dataset_to_index"]) != start + n:
             problems.append(f"{name}: the data files hold {len(rows)} frames, its table {n}")
             continue
-        steps = np.arange(n)
-        task = frames["task_index"][rows]
-        book = {
-            "frame_index": np.array_equal(frames["frame_index"][rows], steps),
-            "index": np.array_equal(frames["index"][rows], start + steps),
-            "timestamp": np.array_equal(
-                frames["timestamp"][rows], (steps / fps).astype(np.float32)
-            ),
-            "task_index": bool((task == task[0]).all() and 0 <= task[0] < tasks),
-        }
-        problems += [
-            f"{name}: its {k} column is not as written" for k, ok in book.items() if not ok
-        ]
+        problems += [f"{name}: {p}" for p in _bookkeeping(frames, rows, start, meta)]
         record = dict(records[ref])
         if MARK in stored and stored[MARK][e] != record["mark"]:
             marks[e] = record.pop("mark")  # marked after it was built: not a difference
@@ -198,13 +219,7 @@ def differences(
         twin = seen.setdefault(digests[-1], e)
         if twin != e:
             problems.append(f"{name}: the same episode as dataset episode {twin}")
-        for key, want in _expected(logged[ref], features).items():
-            have = frames[key][rows]
-            if have.shape != want.shape:
-                problems.append(f"{name}: {key} has shape {have.shape}, its log {want.shape}")
-            elif not np.array_equal(have, want, equal_nan=have.dtype.kind == "f"):
-                at = _first_difference(have, want)
-                problems.append(f"{name}: {key} differs from its log at frame {at}")
+        problems += [f"{name}: {p}" for p in _frame_problems(frames, rows, logged[ref], features)]
     if where:
         problems.append(
             f"the data files hold frames of episodes {sorted(where)[:5]} no table lists"
