@@ -61,7 +61,10 @@ def _running(p: argparse.ArgumentParser) -> None:
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
+    import textwrap
+
     from gymfg_il import cli
+    from gymfg_il.cockpit.inputs.keys import keys_help
     from gymfg_il.collectors.commands import (
         RecoverConfig,
         ReindexConfig,
@@ -105,8 +108,13 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         "manual",
         help="a person flies (keyboard, mouse, joystick or FlightGear's cockpit) in a pygame "
         "window; every completed episode is saved at once",
-        description="A person flies in real time; Space starts an episode, E saves it, "
-        "Backspace discards it, T takes over from --assist, Q quits.",
+        description=textwrap.fill(
+            "A person flies in real time; Space starts an episode, E saves it, Backspace "
+            "discards it, T takes over from --assist, Q quits. Every key is listed below.",
+            79,
+        ),
+        epilog=keys_help(),  # built from the bindings, as the manual guide's table
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     cli.add_fields(
         manual,

@@ -1,6 +1,7 @@
 """The documentation: the site builds with ``mkdocs build --strict`` (a broken link, anchor or
-API reference fails), its generated references cover the package, and every Python block of
-the site and the README runs as written."""
+API reference fails), its generated references cover the package, every Python block of the
+site and the README runs as written, every command parses, and the pictures of the window
+are the window the code draws."""
 
 import ast
 import importlib.util
@@ -176,3 +177,51 @@ def test_every_documented_command_parses(argv, monkeypatch, capsys):
     with pytest.raises(Parsed):
         module.main(argv[1:])
     assert "error:" not in capsys.readouterr().err
+
+
+# the window's pictures, as docs/experiments/pictures.sh (make pictures) makes them: gui.png
+# with no task, and window_<task>.png for each task of its loop
+PICTURES_SH = (ROOT / "docs/experiments/pictures.sh").read_text()
+GUI_SHOT = re.search(r'python -m gymfg_il\.cockpit\.screenshot "\$OUT/gui\.png"\n', PICTURES_SH)
+TASK_SHOTS = re.search(
+    r"for TASK in ([\w -]+); do\n\s+"
+    r'python -m gymfg_il\.cockpit\.screenshot "\$OUT/window_\$TASK\.png" --task "\$TASK"\n',
+    PICTURES_SH,
+)
+WINDOW_PICTURES = {
+    "gui.png": [],
+    **{f"window_{t}.png": ["--task", t] for t in (TASK_SHOTS[1].split() if TASK_SHOTS else [])},
+}
+
+
+def test_pictures_sh_makes_every_window_picture_of_the_docs():
+    assert GUI_SHOT and TASK_SHOTS, "pictures.sh no longer makes the window's pictures so"
+    made = {p.name for p in (ROOT / "docs/images").glob("window_*.png")} | {"gui.png"}
+    assert made == set(WINDOW_PICTURES)
+
+
+@pytest.mark.parametrize("picture", WINDOW_PICTURES)
+def test_the_window_pictures_show_the_window_the_code_draws(picture, tmp_path):
+    """#53: gui.png showed an older window than the code drew. Each window picture is drawn
+    again, as pictures.sh draws it (the dummy video driver, fixed seeds: the same pixels on
+    every run), and held to the committed one pixel for pixel."""
+    import numpy as np
+    from PIL import Image  # matplotlib's
+
+    drawn = tmp_path / picture
+    env = {**os.environ, "HF_HUB_OFFLINE": "1", "SDL_VIDEODRIVER": "dummy"}
+    argv = ["-m", "gymfg_il.cockpit.screenshot", str(drawn), *WINDOW_PICTURES[picture]]
+    run = subprocess.run(
+        [sys.executable, *argv], cwd=ROOT, env=env, capture_output=True, text=True, timeout=600
+    )
+    assert run.returncode == 0, run.stderr[-3000:]
+    new, old = (
+        np.asarray(Image.open(p).convert("RGB")) for p in (drawn, ROOT / "docs/images" / picture)
+    )
+    if new.shape != old.shape:
+        differ = f"it is {old.shape[1]}x{old.shape[0]}, the window {new.shape[1]}x{new.shape[0]}"
+    else:
+        differ = f"{int(np.any(new != old, axis=2).sum())} pixels differ"
+    assert new.shape == old.shape and np.array_equal(new, old), (
+        f"docs/images/{picture} is not the window the code draws ({differ}): run make pictures"
+    )

@@ -12,8 +12,11 @@ DEADLINE_S = 300  # only a hang reaches it: the refusal comes before anything is
 
 
 def collect_manual(tmp_path, env_changes, *extra):
-    env = {**os.environ, "HF_HUB_OFFLINE": "1", **env_changes}
-    for name in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER"):
+    """``collect manual``'s stderr, where it refuses; a variable of ``env_changes`` that is
+    None, and the display's variables not given, are unset."""
+    env = {**os.environ, "HF_HUB_OFFLINE": "1"}
+    env.update({name: value for name, value in env_changes.items() if value is not None})
+    for name in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER", *env_changes):
         if env_changes.get(name) is None:
             env.pop(name, None)
     out = tmp_path / "session"
@@ -31,6 +34,8 @@ def collect_manual(tmp_path, env_changes, *extra):
     assert done.returncode == 2, done.stdout + done.stderr
     assert "Traceback" not in done.stderr, done.stderr
     assert not out.exists()  # refused before anything was made
+    # the project's error is the first thing said, and the only one
+    assert done.stderr.startswith("error: ") and done.stderr.count("error:") == 1, done.stderr
     return done.stderr
 
 
@@ -38,6 +43,17 @@ def test_no_display_says_so_and_exits(tmp_path):
     err = collect_manual(tmp_path, {})
     assert "error: collect manual: no display to open the window on" in err
     assert "DISPLAY unset" in err and "--pilot synthetic" in err
+
+
+def test_no_display_is_one_line_with_no_error_of_sdl_before_it(tmp_path):
+    """#53: with XDG_RUNTIME_DIR unset too (a bare ssh session, a container), SDL's Wayland
+    probe wrote "error: XDG_RUNTIME_DIR is invalid or not set in the environment." before
+    the project's own line, which read as a second error."""
+    err = collect_manual(tmp_path, {"XDG_RUNTIME_DIR": None})
+    (line,) = err.splitlines()
+    assert line.startswith("error: collect manual: no display to open the window on")
+    err = collect_manual(tmp_path, {"XDG_RUNTIME_DIR": None, "WAYLAND_DISPLAY": "wayland-0"})
+    assert "WAYLAND_DISPLAY=wayland-0, XDG_RUNTIME_DIR unset" in err  # the probe's hint kept
 
 
 def test_a_display_that_is_not_there_says_so_and_exits(tmp_path):
