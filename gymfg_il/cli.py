@@ -103,12 +103,6 @@ def add_fields(
             continue
         default = defaults.get(f.name, _default(f))
         flag = flags.get(f.name) or f.metadata.get("flag") or "--" + f.name.replace("_", "-")
-        kind = hints[f.name]
-        args = [a for a in typing.get_args(kind) if a is not type(None)]
-        origin = typing.get_origin(kind)
-        if origin in (typing.Union, types.UnionType) and args:
-            kind, origin = args[0], typing.get_origin(args[0])
-            args = list(typing.get_args(args[0]))
         text = docs.get(f.name, "")
         if f.name in shown:
             text += f" (default: {shown[f.name]})"
@@ -127,25 +121,41 @@ def add_fields(
                 options["nargs"] = "?"
         elif required and not overrides_only:
             options["required"] = True
-        if kind is bool:
-            p.add_argument(flag, action=argparse.BooleanOptionalAction, **options)
-        elif origin is typing.Literal:
-            choices = list(typing.get_args(kind))
-            p.add_argument(flag, choices=choices, type=type(choices[0]), **options)
-        elif origin in (list, tuple):
-            # a repeatable flag gathers every use (--policy A --policy B); others take one list;
-            # a fixed-length tuple takes exactly its length
-            fixed = origin is tuple and Ellipsis not in args
-            nargs: int | str = len(args) if fixed else "+"
-            action = "extend" if f.metadata.get("repeat") else "store"
-            p.add_argument(
-                flag, nargs=nargs, type=args[0] if args else str, action=action, **options
-            )
-        elif kind in (int, float, str, Path):
-            p.add_argument(flag, type=kind, **options)
-        elif required:
+        if not _add_flag(p, flag, hints[f.name], f, options) and required:
             raise TypeError(f"{cls.__name__}.{f.name}: a required field no flag can give")
-        # dict-valued and other structured fields come from recipes, not flags
+
+
+def _add_flag(
+    p: argparse.ArgumentParser,
+    flag: str,
+    hint: Any,
+    f: dataclasses.Field[Any],
+    options: dict[str, Any],
+) -> bool:
+    """Add the flag a field of type ``hint`` takes; False for a type no flag gives (dict-valued
+    and other structured fields come from recipes, not flags)."""
+    kind, origin = hint, typing.get_origin(hint)
+    args = [a for a in typing.get_args(kind) if a is not type(None)]
+    if origin in (typing.Union, types.UnionType) and args:
+        kind, origin = args[0], typing.get_origin(args[0])
+        args = list(typing.get_args(args[0]))
+    if kind is bool:
+        p.add_argument(flag, action=argparse.BooleanOptionalAction, **options)
+    elif origin is typing.Literal:
+        choices = list(typing.get_args(kind))
+        p.add_argument(flag, choices=choices, type=type(choices[0]), **options)
+    elif origin in (list, tuple):
+        # a repeatable flag gathers every use (--policy A --policy B); others take one list;
+        # a fixed-length tuple takes exactly its length
+        fixed = origin is tuple and Ellipsis not in args
+        nargs: int | str = len(args) if fixed else "+"
+        action = "extend" if f.metadata.get("repeat") else "store"
+        p.add_argument(flag, nargs=nargs, type=args[0] if args else str, action=action, **options)
+    elif kind in (int, float, str, Path):
+        p.add_argument(flag, type=kind, **options)
+    else:
+        return False
+    return True
 
 
 def build(cls: type, ns: argparse.Namespace, **extra: Any) -> Any:

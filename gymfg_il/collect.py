@@ -22,7 +22,7 @@ import dataclasses
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from gymfg_il.collectors.config import MANUAL_HZ
 
@@ -60,45 +60,34 @@ def _running(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
-def parse_args(argv: list[str]) -> argparse.Namespace:
+def _recipe_parser() -> argparse.ArgumentParser:
+    """``collect RECIPE.toml [options]``: the recipe's options, each overriding the file."""
+    from gymfg_il import cli
+    from gymfg_il.collectors.config import ManualConfig
+
+    r = cli.parser(
+        "python -m gymfg_il.collect RECIPE.toml",
+        "Run a collection recipe (collectors/*.toml); options override the recipe.",
+    )
+    r.add_argument("recipe", type=Path)
+    cli.add_fields(r, ManualConfig, overrides_only=True)
+    r.add_argument(
+        "--fps", dest="agent_hz", type=int, default=cli.SUPPRESS, help="the same as --agent-hz"
+    )
+    _running(r)
+    return r
+
+
+def _flying(sub: Any) -> None:
+    """The subcommands that fly: autopilot, manual, dagger."""
     import textwrap
 
     from gymfg_il import cli
     from gymfg_il.cockpit.inputs.keys import keys_help
-    from gymfg_il.collectors.commands import (
-        RecoverConfig,
-        ReindexConfig,
-        RepairConfig,
-        ReplayConfig,
-    )
     from gymfg_il.collectors.config import CollectConfig, ManualConfig
     from gymfg_il.envs.options import TASK_OWN_TIME, unset_values
     from gymfg_il.learning.dagger import DaggerConfig
 
-    if argv and argv[0].endswith(".toml"):
-        r = cli.parser(
-            "python -m gymfg_il.collect RECIPE.toml",
-            "Run a collection recipe (collectors/*.toml); options override the recipe.",
-        )
-        r.add_argument("recipe", type=Path)
-        cli.add_fields(r, ManualConfig, overrides_only=True)
-        r.add_argument(
-            "--fps", dest="agent_hz", type=int, default=cli.SUPPRESS, help="the same as --agent-hz"
-        )
-        _running(r)
-        args = r.parse_args(argv)
-        args.command = "recipe"
-        return args
-    p = cli.parser(
-        "python -m gymfg_il.collect",
-        "Record demonstrations: every step to an MCAP log, every completed episode to a "
-        "LeRobot dataset.",
-        EPILOG,
-    )
-    sub = p.add_subparsers(
-        dest="command",
-        metavar="{autopilot,manual,dagger,recover,repair,replay,reindex,export,RECIPE.toml}",
-    )
     # a flight option left out is the flight's default, shown as such
     unset, shown = unset_values(), {"episode_time_s": TASK_OWN_TIME}
     auto = sub.add_parser("autopilot", help="the task's PID controller flies seeded episodes")
@@ -133,14 +122,47 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         "and the policy retrained",
     )
     cli.add_fields(dagger, DaggerConfig)
-    recover = sub.add_parser("recover", help=cli.summary(RecoverConfig))
-    cli.add_fields(recover, RecoverConfig)
-    repair = sub.add_parser("repair", help=cli.summary(RepairConfig))
-    cli.add_fields(repair, RepairConfig)
-    replay = sub.add_parser("replay", help=cli.summary(ReplayConfig))
-    cli.add_fields(replay, ReplayConfig)
-    reindex = sub.add_parser("reindex", help=cli.summary(ReindexConfig))
-    cli.add_fields(reindex, ReindexConfig)
+
+
+def _tools(sub: Any) -> None:
+    """The subcommands that work on a session's files: recover, repair, replay, reindex."""
+    from gymfg_il import cli
+    from gymfg_il.collectors.commands import (
+        RecoverConfig,
+        ReindexConfig,
+        RepairConfig,
+        ReplayConfig,
+    )
+
+    for name, config in (
+        ("recover", RecoverConfig),
+        ("repair", RepairConfig),
+        ("replay", ReplayConfig),
+        ("reindex", ReindexConfig),
+    ):
+        cli.add_fields(sub.add_parser(name, help=cli.summary(config)), config)
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    from gymfg_il import cli
+
+    if argv and argv[0].endswith(".toml"):
+        r = _recipe_parser()
+        args = r.parse_args(argv)
+        args.command = "recipe"
+        return args
+    p = cli.parser(
+        "python -m gymfg_il.collect",
+        "Record demonstrations: every step to an MCAP log, every completed episode to a "
+        "LeRobot dataset.",
+        EPILOG,
+    )
+    sub = p.add_subparsers(
+        dest="command",
+        metavar="{autopilot,manual,dagger,recover,repair,replay,reindex,export,RECIPE.toml}",
+    )
+    _flying(sub)
+    _tools(sub)
     _exports(sub)
     args = p.parse_args(argv)
     if args.command is None:
