@@ -133,13 +133,31 @@ class DatasetBuilder:
         """Append one episode; ``columns`` maps each of our features to a (frames, ...) array
         (the environment state, when left out, is taken from ``observation.state``), ``images``
         each camera feature to its (frames, H, W, 3) uint8 frames."""
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
         meta = self.meta
         n = len(columns["action"])
         if n == 0:
             raise ConfigError("an episode needs at least one frame")
+        index = meta.total_episodes
+        start = meta.total_frames
+        frames = self._frames(self._features(columns, n), n, index, start, task)
+        stats = lr.episode_stats(frames, meta.features)
+        videos = self._add_videos(images or {}, n, stats)
+        chunk, file = self._write(self._table(frames))
+        episode_meta = {
+            "data/chunk_index": chunk,
+            "data/file_index": file,
+            "dataset_from_index": start,
+            "dataset_to_index": start + n,
+            **videos,
+            **self._episode_metadata(metadata or {}),
+        }
+        lr.save_episode(meta, index, n, task, stats, episode_meta)
+        return index
+
+    def _features(self, columns: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
+        """The episode's columns completed (the environment state drawn from the observation,
+        a wall time of none) and checked against the dataset's features, in their order."""
+        meta = self.meta
         given = dict(columns)
         if self._environment is not None and ENVIRONMENT_STATE not in given:
             state = np.asarray(columns["observation.state"])
@@ -151,10 +169,15 @@ class DatasetBuilder:
             raise ConfigError(f"the dataset has no features {unknown}; its: {list(meta.features)}")
         # in the features' order, as LeRobot's writer keeps its statistics; a wall time the
         # dataset has no column for (one begun faster than real time) is left out
-        columns = {k: given[k] for k in meta.features if k in given}
-        index = meta.total_episodes
-        start = meta.total_frames
-        frames = {
+        return {k: given[k] for k in meta.features if k in given}
+
+    def _frames(
+        self, columns: dict[str, np.ndarray], n: int, index: int, start: int, task: str
+    ) -> dict[str, np.ndarray]:
+        """Every column of the episode's ``n`` frames in LeRobot's dtypes and shapes, with its
+        bookkeeping: timestamps, frame, episode, dataset and task indexes."""
+        meta = self.meta
+        return {
             # shape-(1,) features are scalars per frame, as LeRobot stores them
             **{
                 k: np.asarray(v).reshape(n, *self._shape(k)).astype(meta.features[k]["dtype"])
@@ -167,15 +190,20 @@ class DatasetBuilder:
             "index": np.arange(start, start + n, dtype=np.int64),
             "task_index": np.full(n, lr.task_index(meta, task), dtype=np.int64),
         }
-        stats = lr.episode_stats(frames, meta.features)
+
+    def _add_videos(
+        self, images: dict[str, np.ndarray], n: int, stats: dict[str, Any]
+    ) -> dict[str, Any]:
+        """Append each camera's ``n`` frames to its video file and its statistics to
+        ``stats``; the episode's ``videos/*`` columns (where in which file)."""
         videos: dict[str, Any] = {}
-        missing = sorted(set(self.video_keys) - set(images or {}))
+        missing = sorted(set(self.video_keys) - set(images))
         if missing:
             raise ConfigError(
                 f"the dataset has camera features {missing} but the episode has no frames for them"
             )
         for key in self.video_keys:
-            pictures = (images or {})[key]
+            pictures = images[key]
             if len(pictures) != n:
                 raise ConfigError(f"{key}: {len(pictures)} frames for an episode of {n}")
             stats[key] = lr.image_stats(pictures)
@@ -188,8 +216,15 @@ class DatasetBuilder:
                 f"videos/{key}/from_timestamp": begin,
                 f"videos/{key}/to_timestamp": end,
             }
+        return videos
+
+    def _table(self, frames: dict[str, np.ndarray]) -> Any:
+        """The episode's frames as one Arrow table in LeRobot's schema (timestamps float32,
+        vectors fixed-size lists)."""
+        import pyarrow as pa
+
         if self._schema is None:
-            self._schema = lr.arrow_schema(meta.features)
+            self._schema = lr.arrow_schema(self.meta.features)
         arrays = []
         for field in self._schema:
             values = frames[field.name]
@@ -200,26 +235,22 @@ class DatasetBuilder:
             else:
                 flat = pa.array(values.ravel(), type=field.type.value_type)
                 arrays.append(pa.FixedSizeListArray.from_arrays(flat, values.shape[1]))
-        table = pa.Table.from_arrays(arrays, schema=self._schema)
+        return pa.Table.from_arrays(arrays, schema=self._schema)
+
+    def _write(self, table: Any) -> tuple[int, int]:
+        """Write ``table`` to this build's data file, opened on first use; its (chunk, file)."""
+        import pyarrow.parquet as pq
+
         chunk, file = self._data_file()
         if self._writer is None:
-            path = self.root / meta.data_path.format(chunk_index=chunk, file_index=file)
+            path = self.root / self.meta.data_path.format(chunk_index=chunk, file_index=file)
             path.parent.mkdir(parents=True, exist_ok=True)
             # page checksums: `collect recover` finds a flipped byte in a data page
             self._writer = pq.ParquetWriter(
                 path, schema=self._schema, compression="snappy", write_page_checksum=True
             )
         self._writer.write_table(table)
-        episode_meta = {
-            "data/chunk_index": chunk,
-            "data/file_index": file,
-            "dataset_from_index": start,
-            "dataset_to_index": start + n,
-            **videos,
-            **self._episode_metadata(metadata or {}),
-        }
-        lr.save_episode(meta, index, n, task, stats, episode_meta)
-        return index
+        return chunk, file
 
     def _episode_metadata(self, metadata: dict[str, Any]) -> dict[str, Any]:
         """The ``gymfg/*`` columns of a new episode, as many as the dataset's episodes have."""

@@ -41,7 +41,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -50,6 +50,9 @@ from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.export.credits import Credits, credits
 from gymfg_il.names import BadNameError, name_problem
+
+if TYPE_CHECKING:
+    from gymfg_il.learning.frames import Frames
 
 DATA_FORMAT = "arrow"  # Minari's Arrow storage: pyarrow is here already (LeRobot); no h5py
 NEAR = 1e-3  # relative drift allowed when re-flying from float32 actions (no logs at hand)
@@ -234,6 +237,28 @@ def _refly(
 
     actions, exact = flown_actions
     index, seed = int(meta["episode_index"]), int(meta["gymfg/seed"])
+    flown, rewards, terms, truncs = _fly(env, actions, index, seed)
+    _check_departure(flown, obs, exact, index, seed)
+    if not exact:
+        flown[: len(obs)] = obs  # the dataset's own; only the last comes from the flight
+    return EpisodeBuffer(
+        id=None,
+        seed=seed,
+        observations=flown,
+        actions=actions.astype(np.float32),  # the action space's dtype
+        rewards=np.array(rewards),
+        terminations=np.array(terms),
+        truncations=np.array(truncs),
+        infos={"label": np.concatenate([labels, labels[-1:]])},
+    )
+
+
+def _fly(
+    env: Any, actions: np.ndarray, index: int, seed: int
+) -> tuple[np.ndarray, list[float], list[bool], list[bool]]:
+    """Episode ``index`` flown in ``env`` from ``seed`` with ``actions``: (its N + 1
+    observations, its rewards, terminations and truncations), or an error where it ends
+    before or after the dataset's episode."""
     first, _ = env.reset(seed=seed)
     observations = [np.asarray(first, np.float32)]
     rewards, terms, truncs = [], [], []
@@ -253,7 +278,14 @@ def _refly(
             f"episode {index} (seed {seed}) has not ended after its {len(actions)} steps when "
             "flown again in its env"
         )
-    flown = np.stack(observations)
+    return np.stack(observations), rewards, terms, truncs
+
+
+def _check_departure(
+    flown: np.ndarray, obs: np.ndarray, exact: bool, index: int, seed: int
+) -> None:
+    """Raise where the re-flown observations depart from the dataset's ``obs``: at all for
+    ``exact`` actions, beyond float32 rounding (``NEAR``) for the dataset's own."""
     if exact:
         apart = flown[: len(obs)] != obs
     else:  # float32-rounded actions: the flight drifts by rounding only
@@ -270,18 +302,6 @@ def _refly(
             f"episode {index} (seed {seed}) departs from the dataset at frame {differs[0]} "
             f"when flown again in its env ({why}); it cannot be exported with its env"
         )
-    if not exact:
-        flown[: len(obs)] = obs  # the dataset's own; only the last comes from the flight
-    return EpisodeBuffer(
-        id=None,
-        seed=seed,
-        observations=flown,
-        actions=actions.astype(np.float32),  # the action space's dtype
-        rewards=np.array(rewards),
-        terminations=np.array(terms),
-        truncations=np.array(truncs),
-        infos={"label": np.concatenate([labels, labels[-1:]])},
-    )
 
 
 def export_dataset(
@@ -298,6 +318,42 @@ def export_dataset(
     MinariConfig(dataset, name, root)  # the id's rule
     folder, logs = _locate(dataset)
     frames = load_frames(folder)
+    flight = _solo_flight(frames, folder)
+    spec = env_spec(flight)
+    env = gym.make(spec)
+    try:
+        buffers = _refly_all(env, spec.id, frames, logs)
+    finally:
+        env.close()
+    sources = sorted(set(frames.episodes.get("gymfg/source", [])))
+    made_by = made_by if made_by is not None else credits()
+    with minari_root(root) as where, _writing(where, name):
+        minari.create_dataset_from_buffers(
+            dataset_id=name,
+            buffer=buffers,
+            env=spec,
+            algorithm_name=", ".join(sources) or None,
+            author=set(made_by.author) or None,
+            author_email=set(made_by.author_email) or None,
+            code_permalink=made_by.code_permalink,
+            requirements=list(made_by.requirements) or None,
+            description=(
+                f"GymFG-IL demonstrations exported from the LeRobot dataset {folder.name}: "
+                f"{flight.aircraft} flying {flight.task_label} at {flight.agent_hz} Hz "
+                f"(JSBSim); observation names {', '.join(frames.observation_names)}; "
+                "infos['label'] is the demonstrator's action"
+            ),
+            observation_space=env.observation_space,
+            action_space=env.action_space,
+            data_format=DATA_FORMAT,
+        )
+    steps = int(sum(len(b.rewards) for b in buffers))
+    return MinariSummary(name, where, len(buffers), steps, str(spec.id), made_by)
+
+
+def _solo_flight(frames: Frames, folder: Path) -> FlightSpec:
+    """The one solo flight every episode of the dataset at ``folder`` was flown as, or an
+    error saying why there is none."""
     flight, why = frames.flight()
     if flight is None:
         raise ConfigError(f"the dataset at {folder} names no one flight: {why}")
@@ -311,52 +367,42 @@ def export_dataset(
             "flew beside other aircraft); a Minari dataset names one gymnasium env, which "
             "flies one aircraft: export a solo dataset"
         )
-    spec = env_spec(flight)
+    return flight
+
+
+def _refly_all(env: Any, env_id: str, frames: Frames, logs: Path | None) -> list[Any]:
+    """Every episode of ``frames`` flown again in ``env`` (the one of id ``env_id``, whose
+    observations must be the dataset's), with its flown actions from ``logs`` where they are
+    at hand; their Minari buffers, in the dataset's order."""
+    names = list(env.get_wrapper_attr("observation_names"))
+    if frames.observation_names != names:
+        raise ConfigError(
+            f"the dataset's observation names {frames.observation_names} are not those "
+            f"of its env {env_id} ({names}); it cannot be exported with its env"
+        )
     flown = _FlownActions(logs)
     columns = frames.episodes
     buffers = []
-    env = gym.make(spec)
-    try:
-        names = list(env.get_wrapper_attr("observation_names"))
-        if frames.observation_names != names:
-            raise ConfigError(
-                f"the dataset's observation names {frames.observation_names} are not those "
-                f"of its env {spec.id} ({names}); it cannot be exported with its env"
-            )
-        for i, episode in enumerate(columns["episode_index"]):
-            meta = {k: v[i] for k, v in columns.items()}
-            rows = frames.episode == episode
-            order = np.argsort(frames.frame[rows])
-            obs, labels = frames.obs[rows][order], frames.action[rows][order]
-            buffers.append(_refly(env, meta, obs, flown(meta, labels), labels))
-    finally:
-        env.close()
-    sources = sorted(set(columns.get("gymfg/source", [])))
-    made_by = made_by if made_by is not None else credits()
-    with minari_root(root) as where, warnings.catch_warnings():
+    for i, episode in enumerate(columns["episode_index"]):
+        meta = {k: v[i] for k, v in columns.items()}
+        rows = frames.episode == episode
+        order = np.argsort(frames.frame[rows])
+        obs, labels = frames.obs[rows][order], frames.action[rows][order]
+        buffers.append(_refly(env, meta, obs, flown(meta, labels), labels))
+    return buffers
+
+
+@contextmanager
+def _writing(where: Path, name: str) -> Iterator[None]:
+    """Minari writing the dataset ``name`` under ``where``: without its warnings about
+    settings left unset, and leaving no half-written dataset behind; one that exists already
+    is a ConfigError."""
+    with warnings.catch_warnings():
         assert (where / name).resolve().is_relative_to(where), name  # the id's rule keeps it in
         for what in ("code_permalink", "author", "author_email", "eval_env"):
             warnings.filterwarnings("ignore", message=f"`{what}` is set to None")
         try:
-            minari.create_dataset_from_buffers(
-                dataset_id=name,
-                buffer=buffers,
-                env=spec,
-                algorithm_name=", ".join(sources) or None,
-                author=set(made_by.author) or None,
-                author_email=set(made_by.author_email) or None,
-                code_permalink=made_by.code_permalink,
-                requirements=list(made_by.requirements) or None,
-                description=(
-                    f"GymFG-IL demonstrations exported from the LeRobot dataset {folder.name}: "
-                    f"{flight.aircraft} flying {flight.task_label} at {flight.agent_hz} Hz "
-                    f"(JSBSim); observation names {', '.join(frames.observation_names)}; "
-                    "infos['label'] is the demonstrator's action"
-                ),
-                observation_space=env.observation_space,
-                action_space=env.action_space,
-                data_format=DATA_FORMAT,
-            )
+            yield
         except ValueError as err:
             if "already exists" in str(err):
                 raise ConfigError(
@@ -368,8 +414,6 @@ def export_dataset(
         except BaseException:
             shutil.rmtree(where / name, ignore_errors=True)
             raise
-    steps = int(sum(len(b.rewards) for b in buffers))
-    return MinariSummary(name, where, len(buffers), steps, str(spec.id), made_by)
 
 
 def export_minari(cfg: MinariConfig) -> int:

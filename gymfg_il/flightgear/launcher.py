@@ -63,6 +63,44 @@ def find_fgfs() -> str | None:
     return shutil.which("fgfs", path=os.pathsep.join(SEARCH))
 
 
+def _check_multiplayer(multiplayer_port: int | None, multiplayer_out: int | None) -> None:
+    """Raise unless the multiplayer ports are ones FlightGear can use, the out port only
+    with an in port."""
+    from gymfg_il.flightgear.multiplayer import port_problem
+
+    problems = [port_problem(p) for p in (multiplayer_port, multiplayer_out) if p is not None]
+    if any(problems):
+        raise FlightGearError("; ".join(p for p in problems if p))
+    if multiplayer_out is not None and multiplayer_port is None:
+        raise FlightGearError(
+            "multiplayer_out needs a multiplayer_port too: without --multiplay=in fgfs "
+            "binds its out port itself"
+        )
+
+
+def _following(port: int | None, rate_hz: int) -> tuple[str, ...]:
+    """The options that make fgfs draw the native-fdm stream on ``port`` instead of flying
+    with its own FDM (none without a port)."""
+    if port is None:
+        return ()
+    return ("--fdm=null", f"--native-fdm=socket,in,{rate_hz},,{port},udp")
+
+
+def _traffic(
+    rate_hz: int, multiplayer_port: int | None, multiplayer_out: int | None, callsign: str
+) -> tuple[str, ...]:
+    """The options that show other aircraft, from ``multiplayer_port`` (none without it)."""
+    if not multiplayer_port:
+        return ()
+    # FlightGear only listens when it also has somewhere to send its own position: the
+    # discard port, so no view ever sees another view's aircraft twice
+    return (
+        f"--multiplay=in,{rate_hz},127.0.0.1,{multiplayer_port}",
+        f"--multiplay=out,{rate_hz},127.0.0.1,{multiplayer_out or 9}",
+        f"--callsign={callsign}",
+    )
+
+
 class FlightGear:
     """A running ``fgfs`` bound to one native-fdm UDP port.
 
@@ -99,16 +137,7 @@ class FlightGear:
         multiplayer_out: int | None = None,
         callsign: str = "gymfg-view",
     ) -> None:
-        from gymfg_il.flightgear.multiplayer import port_problem
-
-        problems = [port_problem(p) for p in (multiplayer_port, multiplayer_out) if p is not None]
-        if any(problems):
-            raise FlightGearError("; ".join(p for p in problems if p))
-        if multiplayer_out is not None and multiplayer_port is None:
-            raise FlightGearError(
-                "multiplayer_out needs a multiplayer_port too: without --multiplay=in fgfs "
-                "binds its out port itself"
-            )
+        _check_multiplayer(multiplayer_port, multiplayer_out)
         exe = find_fgfs()
         if exe is None:
             raise FlightGearError(
@@ -117,26 +146,10 @@ class FlightGear:
             )
         self.port, self.telnet_port = port, telnet_port
         self.multiplayer_port = multiplayer_port
-        # FlightGear only listens when it also has somewhere to send its own position: the
-        # discard port, so no view ever sees another view's aircraft twice
-        traffic = (
-            (
-                f"--multiplay=in,{rate_hz},127.0.0.1,{multiplayer_port}",
-                f"--multiplay=out,{rate_hz},127.0.0.1,{multiplayer_out or 9}",
-                f"--callsign={callsign}",
-            )
-            if multiplayer_port
-            else ()
-        )
         self.home = tempfile.mkdtemp(prefix="gymfg-fghome-")
-        follow = (
-            ("--fdm=null", f"--native-fdm=socket,in,{rate_hz},,{port},udp")
-            if port is not None
-            else ()
-        )
         cmd = [
             exe,
-            *follow,
+            *_following(port, rate_hz),
             f"--aircraft={aircraft}",
             f"--telnet=socket,bi,30,localhost,{telnet_port},tcp",  # served each frame
             "--disable-sound",
@@ -149,9 +162,15 @@ class FlightGear:
             f"--airport={airport}",
             "--prop:/sim/rendering/multi-sample-buffers=0",
             *(FUEL_TANKS if port is not None else ()),
-            *traffic,
+            *_traffic(rate_hz, multiplayer_port, multiplayer_out, callsign),
             *extra,
         ]
+        self._start(cmd, display)
+        self._sock: socket.socket | None = None
+
+    def _start(self, cmd: list[str], display: str | None) -> None:
+        """Run ``cmd`` (under ``dbus-run-session`` where there is one) in its own session,
+        its FG_HOME this view's, its output into ``log_path``."""
         if shutil.which("dbus-run-session"):
             cmd = ["dbus-run-session", "--", *cmd]
         env = {**os.environ, "FG_HOME": self.home}
@@ -162,7 +181,6 @@ class FlightGear:
         self.proc = subprocess.Popen(
             cmd, env=env, stdout=self._log, stderr=subprocess.STDOUT, start_new_session=True
         )
-        self._sock: socket.socket | None = None
 
     def wait_ready(self, timeout_s: float = 300.0) -> None:
         """Wait until FlightGear has loaded its scenery (the first start also builds a navaid

@@ -24,6 +24,15 @@ FORMAT = ">I4x3d6f11f3f2fI4I36fI4fI3I9fIif10f"
 SIZE = struct.calcsize(FORMAT)
 assert SIZE == 408, SIZE
 
+# engine gauges FlightGear shows that the view need not take from JSBSim, 4 engines each:
+# fuel pressure (psi); after the EGT, cylinder head temperature (degF), manifold pressure
+# (inHg), turbine inlet temperature, oil temperature (degF) and oil pressure (psi)
+_FUEL_PRESSURE = (30.0,) * 4
+_AFTER_EGT = (300.0,) * 4 + (20.0,) * 4 + (0.0,) * 4 + (180.0,) * 4 + (60.0,) * 4
+# the 3 wheels' steering and compression, then cur_time (0: FlightGear keeps its own time
+# of day) and warp
+_AFTER_GEAR = (0.0,) * 3 + (0.0,) * 3 + (0, 0)
+
 
 def _get(fdm: Any, prop: str, default: float = 0.0) -> float:
     try:
@@ -34,8 +43,37 @@ def _get(fdm: Any, prop: str, default: float = 0.0) -> float:
 
 def pack(fdm: Any, engines: int, visibility_m: float = 20000.0) -> bytes:
     """One packet describing the JSBSim instance ``fdm`` now."""
-    g = fdm.__getitem__
     n = min(engines, 4)
+    state, rpm, fuel_flow, egt = _engines(fdm, n)
+    tanks = [_get(fdm, f"propulsion/tank[{i}]/contents-lbs") / 6.0 for i in range(4)]  # US gal
+    n_tanks = sum(1 for t in tanks if t > 0) or 1
+    wow = [int(_get(fdm, f"gear/unit[{i}]/WOW")) for i in range(3)]
+    down = _get(fdm, "gear/gear-pos-norm")  # a wheel's position where it has none of its own
+    gear = [_get(fdm, f"gear/unit[{i}]/pos-norm", down) for i in range(3)]
+    return struct.pack(
+        FORMAT,
+        VERSION,
+        *_motion(fdm),
+        n,
+        *state,
+        *rpm,
+        *fuel_flow,
+        *_FUEL_PRESSURE,
+        *egt,
+        *_AFTER_EGT,
+        n_tanks,
+        *tanks,
+        3,
+        *wow,
+        *gear,
+        *_AFTER_GEAR,
+        visibility_m,
+        *_surfaces(fdm),
+    )
+
+
+def _engines(fdm: Any, n: int) -> tuple[list[int], list[float], list[float], list[float]]:
+    """The first ``n`` engines' (state, rpm, fuel flow in gal/h, EGT in degF), 4 each."""
     rpm, fuel_flow, egt, state = [0.0] * 4, [0.0] * 4, [0.0] * 4, [0] * 4
     for i in range(n):
         base = f"propulsion/engine[{i}]/"
@@ -43,16 +81,14 @@ def pack(fdm: Any, engines: int, visibility_m: float = 20000.0) -> bytes:
         fuel_flow[i] = _get(fdm, base + "fuel-flow-rate-pps") * 3600.0 / 6.0  # gal/h (avgas)
         egt[i] = _get(fdm, base + "egt-degF", 1200.0)
         state[i] = 2 if _get(fdm, base + "set-running", 1.0) else 0
-    tanks = [0.0] * 4
-    for i in range(4):
-        tanks[i] = _get(fdm, f"propulsion/tank[{i}]/contents-lbs") / 6.0  # US gal
-    n_tanks = sum(1 for t in tanks if t > 0) or 1
-    wow = [int(_get(fdm, f"gear/unit[{i}]/WOW")) for i in range(3)]
-    gear = [
-        _get(fdm, f"gear/unit[{i}]/pos-norm", _get(fdm, "gear/gear-pos-norm")) for i in range(3)
-    ]
-    values: list[float | int] = [
-        VERSION,
+    return state, rpm, fuel_flow, egt
+
+
+def _motion(fdm: Any) -> tuple[float, ...]:
+    """Position (lon, lat, alt and agl in m), attitude, aerodynamic angles, body rates,
+    speeds, pilot accelerations and the stall warning and slip (FlightGear's order)."""
+    g = fdm.__getitem__
+    return (
         g("position/long-gc-rad"),
         g("position/lat-geod-rad"),
         g("position/h-sl-ft") * FT_TO_M,
@@ -78,39 +114,25 @@ def pack(fdm: Any, engines: int, visibility_m: float = 20000.0) -> bytes:
         g("accelerations/a-pilot-z-ft_sec2"),
         0.0,
         g("aero/beta-deg"),
-        n,
-        *state,
-        *rpm,
-        *fuel_flow,
-        *([30.0] * 4),
-        *egt,
-        *([300.0] * 4),
-        *([20.0] * 4),
-        *([0.0] * 4),
-        *([180.0] * 4),
-        *([60.0] * 4),
-        n_tanks,
-        *tanks,
-        3,
-        *wow,
-        *gear,
-        *([0.0] * 3),
-        *([0.0] * 3),
-        0,
-        0,
-        visibility_m,  # cur_time 0: FlightGear keeps its own time of day
+    )
+
+
+def _surfaces(fdm: Any) -> tuple[float, ...]:
+    """The 10 control-surface fields: elevator, its trim tab, left and right flap, left and
+    right aileron, rudder, nose wheel, speedbrake, spoilers."""
+    flaps = _get(fdm, "fcs/flap-pos-norm")
+    return (
         _get(fdm, "fcs/elevator-pos-rad"),
         0.0,
-        _get(fdm, "fcs/flap-pos-norm"),
-        _get(fdm, "fcs/flap-pos-norm"),
+        flaps,
+        flaps,
         _get(fdm, "fcs/left-aileron-pos-rad"),
         _get(fdm, "fcs/right-aileron-pos-rad"),
         _get(fdm, "fcs/rudder-pos-rad"),
         0.0,
         0.0,
         0.0,
-    ]
-    return struct.pack(FORMAT, *values)
+    )
 
 
 class FlightGearSender:

@@ -85,14 +85,9 @@ def _train(
     frames: Frames | None,
     on_start: Callable[[Estimate], None] | None,
 ) -> TrainResult:
-    import torch
-
     from gymfg_il.learning.data import split_by_episode
     from gymfg_il.learning.fit import Steps, estimate, fit
     from gymfg_il.learning.saving import check_diverged, save_run
-    from gymfg_il.policies.checkpoint_folder import check_out
-    from gymfg_il.policies.configuration import DatasetInfo
-    from gymfg_il.policies.factory import make_policy
 
     device = resolve_device(cfg.device)
     window = cfg.policy.window
@@ -100,21 +95,10 @@ def _train(
     shift: dict[str, Any] = {}
     frames = demonstrations(cfg, frames, window.camera, shift)
     flight, why = frames.flight()
-    if flight is None:
-        log.warning(
-            "the policy records no flight spec: %s; eval will need --task and --aircraft", why
-        )
-    name = f"bc-{flight.task_label if flight else 'task'}-"
-    name += f"{flight.aircraft if flight else 'aircraft'}-{cfg.policy.type}"
-    out = Path(cfg.out) if cfg.out is not None else unused(Path("policies") / name)
-    check_out(out)  # before training, not after
+    name, out = _destination(cfg, flight, why)
     train, val = split_by_episode(frames, cfg.val_fraction, cfg.seed)
     image_size = None if frames.images is None else int(frames.images.shape[1])
-    data = DatasetInfo(list(frames.observation_names), frames.fps, flight, image_size)
-    config = cfg.policy.for_data(data)
-    torch.manual_seed(cfg.seed)
-    policy = make_policy(config, frames.obs_stats, frames.action_stats).to(device)
-    policy.obs_noise = cfg.obs_noise
+    policy = _policy(cfg, frames, flight, image_size, device)
     batches, val_batches = _batches(train, val, cfg, window, device)
     # the batches hold the pooled camera frames: the full-size ones of the split go (vision
     # DAgger on 60 episodes ran out of memory with them kept), but the caller's
@@ -143,6 +127,44 @@ def _train(
     stats = (frames.obs_stats, frames.action_stats)
     save_run(out, policy.cpu(), meta, stats, (train_loss, val_loss))
     return TrainResult(out, train_loss, val_loss, seconds, len(train) * steps.epochs, meta)
+
+
+def _destination(cfg: TrainConfig, flight: FlightSpec | None, why: str) -> tuple[str, Path]:
+    """The policy's name (task, aircraft, type) and the folder it is saved to (``cfg.out``,
+    else an unused one under policies/), checked before training rather than after."""
+    from gymfg_il.policies.checkpoint_folder import check_out
+
+    if flight is None:
+        log.warning(
+            "the policy records no flight spec: %s; eval will need --task and --aircraft", why
+        )
+    name = f"bc-{flight.task_label if flight else 'task'}-"
+    name += f"{flight.aircraft if flight else 'aircraft'}-{cfg.policy.type}"
+    out = Path(cfg.out) if cfg.out is not None else unused(Path("policies") / name)
+    check_out(out)  # before training, not after
+    return name, out
+
+
+def _policy(
+    cfg: TrainConfig,
+    frames: Frames,
+    flight: FlightSpec | None,
+    image_size: int | None,
+    device: str,
+) -> Any:
+    """The policy ``cfg`` configures, made for the data of ``frames`` (its observations,
+    rate, flight and camera size) and seeded with ``cfg.seed``, on ``device``."""
+    import torch
+
+    from gymfg_il.policies.configuration import DatasetInfo
+    from gymfg_il.policies.factory import make_policy
+
+    data = DatasetInfo(list(frames.observation_names), frames.fps, flight, image_size)
+    config = cfg.policy.for_data(data)
+    torch.manual_seed(cfg.seed)
+    policy = make_policy(config, frames.obs_stats, frames.action_stats).to(device)
+    policy.obs_noise = cfg.obs_noise
+    return policy
 
 
 def unused(folder: Path) -> Path:

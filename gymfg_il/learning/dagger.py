@@ -105,36 +105,11 @@ def run_dagger(
     if iterations < 1 or episodes < 1:
         raise ConfigError("iterations and episodes must be >= 1")
     meta = AgentSpec.policy(policy).meta()
-    if not meta.get("spec"):
-        raise ConfigError(
-            f"{policy} records no flight spec (trained on a dataset made before gymfg-il 0.2); "
-            "DAgger flies the policy's own flight: rebuild the dataset with `collect recover` "
-            "and train again"
-        )
-    flight = FlightSpec.from_dict(meta["spec"])
+    flight = _own_flight(policy, meta)
     root = out / DATASET
-    base = Path(meta.get("dataset", ""))
     if not root.exists():
-        if not (base / "meta" / "info.json").is_file():
-            raise ConfigError(f"the policy's dataset {base} is gone; DAgger aggregates onto it")
-        out.mkdir(parents=True, exist_ok=True)
-        # the base episodes' logs come along, so `collect recover` rebuilds every episode
-        unlinked = link_base_logs(base, out / LOGS)
-        shutil.copytree(base, root)
-        if unlinked:
-            log.warning(
-                "%d episode(s) of %s have no log to take along; `collect recover %s` cannot "
-                "rebuild them: %s",
-                len(unlinked),
-                base,
-                out,
-                "; ".join(unlinked[:5]),
-            )
-    # a camera dataset stays one: the new rounds draw the same views at the same size
-    root_meta = lr.open_metadata(root)
-    cameras = root_meta.video_keys
-    views = [k.removeprefix(IMAGE_PREFIX) for k in cameras]
-    size = int(root_meta.features[cameras[0]]["shape"][0]) if cameras else 128
+        _start_session(Path(meta.get("dataset", "")), out)
+    cameras = _cameras(root)
     current = Path(policy)
     history = []
     # one pool for every round, forked before training starts threads in this process
@@ -142,17 +117,9 @@ def run_dagger(
         for it in range(1, iterations + 1):
             seeds = range(seed + (it - 1) * episodes, seed + it * episodes)
             session = record_session(
-                flight,
-                AgentSpec.policy(current),
-                AgentSpec.controller(),
-                seeds,
-                out,
-                "dagger",
-                workers=pool,
-                iteration=it,
-                images=views,
-                image_size=size,
-            )
+                flight, AgentSpec.policy(current), AgentSpec.controller(), seeds, out,
+                "dagger", workers=pool, iteration=it, **cameras,
+            )  # fmt: skip
             report = build_from_logs(sorted((out / LOGS).glob("*.mcap")), root)
             cfg = retrain_config(meta, root, out / f"policy-{it}", train_overrides)
             result = train_bc(cfg)
@@ -169,6 +136,46 @@ def run_dagger(
             if on_iteration is not None:
                 on_iteration(step)
     return history
+
+
+def _own_flight(policy: Path, meta: dict[str, Any]) -> FlightSpec:
+    """The flight ``policy`` was trained for (``meta``: its config.json), which DAgger flies."""
+    if not meta.get("spec"):
+        raise ConfigError(
+            f"{policy} records no flight spec (trained on a dataset made before gymfg-il 0.2); "
+            "DAgger flies the policy's own flight: rebuild the dataset with `collect recover` "
+            "and train again"
+        )
+    return FlightSpec.from_dict(meta["spec"])
+
+
+def _start_session(base: Path, out: Path) -> None:
+    """Start the session ``out`` from a copy of the policy's dataset ``base``, with the logs
+    of its episodes linked into ``out``'s logs/, so `collect recover` rebuilds every episode."""
+    if not (base / "meta" / "info.json").is_file():
+        raise ConfigError(f"the policy's dataset {base} is gone; DAgger aggregates onto it")
+    out.mkdir(parents=True, exist_ok=True)
+    unlinked = link_base_logs(base, out / LOGS)
+    shutil.copytree(base, out / DATASET)
+    if unlinked:
+        log.warning(
+            "%d episode(s) of %s have no log to take along; `collect recover %s` cannot "
+            "rebuild them: %s",
+            len(unlinked),
+            base,
+            out,
+            "; ".join(unlinked[:5]),
+        )
+
+
+def _cameras(root: Path) -> dict[str, Any]:
+    """The camera settings of the rounds' sessions: a camera dataset stays one, the new
+    rounds drawing the same views at the same size as the dataset at ``root``."""
+    root_meta = lr.open_metadata(root)
+    cameras = root_meta.video_keys
+    views = [k.removeprefix(IMAGE_PREFIX) for k in cameras]
+    size = int(root_meta.features[cameras[0]]["shape"][0]) if cameras else 128
+    return {"images": views, "image_size": size}
 
 
 def retrain_config(

@@ -48,30 +48,8 @@ class StateServer:
         self.auth: Any = None
         self.public_key: bytes | None = None
         if config.curve:
-            import zmq.auth
-            from zmq.auth.thread import ThreadAuthenticator
-
-            self.auth = ThreadAuthenticator(self.ctx)
-            self.auth.start()
-            self.auth.configure_curve(domain="*", location=zmq.auth.CURVE_ALLOW_ANY)
-            public, secret = zmq.curve_keypair()
-            self.sock.curve_secretkey = secret
-            self.sock.curve_publickey = public
-            self.sock.curve_server = True
-            self.public_key = public
-        try:
-            if config.port:
-                self.sock.bind(f"tcp://{config.bind}:{config.port}")
-                self.port = config.port
-            else:
-                self.port = self.sock.bind_to_random_port(f"tcp://{config.bind}")
-        except zmq.ZMQError as err:
-            self.close()
-            where = f"{config.bind}:{config.port or 'any port'}"
-            raise ConfigError(
-                f"cannot listen on {where} ({err}); is another server using the port, or "
-                "is the address not one of this machine's?"
-            ) from None
+            self._encrypt()
+        self.port = self._listen()
         self.view_idx = indices(tuple(config.opponent_view))
         self._view = self.view_idx.tolist()
         self._last_stall_check = 0.0
@@ -99,6 +77,41 @@ class StateServer:
         self._paused_notice = 0.0
         # waiting teams hear why at this interval, and must answer within the timeout
         self._wait_every = min(0.5, config.timeout_s / 4)
+
+    def _encrypt(self) -> None:
+        """CurveZMQ on the socket: a new key pair (the public key in ``public_key``, for the
+        clients) and an authenticator that lets any client key in."""
+        import zmq
+        import zmq.auth
+        from zmq.auth.thread import ThreadAuthenticator
+
+        self.auth = ThreadAuthenticator(self.ctx)
+        self.auth.start()
+        self.auth.configure_curve(domain="*", location=zmq.auth.CURVE_ALLOW_ANY)
+        public, secret = zmq.curve_keypair()
+        self.sock.curve_secretkey = secret
+        self.sock.curve_publickey = public
+        self.sock.curve_server = True
+        self.public_key = public
+
+    def _listen(self) -> int:
+        """Bind the socket to the configured address and port (any free one where none is
+        given); the port. An address it cannot bind closes the server and says why."""
+        import zmq
+
+        config = self.config
+        try:
+            if config.port:
+                self.sock.bind(f"tcp://{config.bind}:{config.port}")
+                return config.port
+            return self.sock.bind_to_random_port(f"tcp://{config.bind}")
+        except zmq.ZMQError as err:
+            self.close()
+            where = f"{config.bind}:{config.port or 'any port'}"
+            raise ConfigError(
+                f"cannot listen on {where} ({err}); is another server using the port, or "
+                "is the address not one of this machine's?"
+            ) from None
 
     @property
     def address(self) -> str:

@@ -217,10 +217,6 @@ def _rewrite(path: Path, tmp: Path, chunk_size: int) -> tuple[int, str]:
         indexes = IndexType.CHUNK | IndexType.MESSAGE | IndexType.METADATA
         if attachments:
             indexes |= IndexType.ATTACHMENT
-        schemas: dict[int, int] = {0: 0}
-        channels: dict[int, int] = {}
-        topics: dict[int, str] = {}
-        count, digest = 0, hashlib.blake2b()
         with open(tmp, "xb") as out:
             writer = Writer(
                 out,
@@ -229,44 +225,10 @@ def _rewrite(path: Path, tmp: Path, chunk_size: int) -> tuple[int, str]:
                 index_types=indexes,
                 enable_data_crcs=True,
             )
+            copy = _Copy(writer)
             try:
                 for record in StreamReader(f, validate_crcs=True).records:
-                    if isinstance(record, Header):
-                        writer.start(profile=record.profile, library=record.library)
-                    elif isinstance(record, Schema):
-                        if record.id not in schemas:
-                            schemas[record.id] = writer.register_schema(
-                                record.name, record.encoding, record.data
-                            )
-                    elif isinstance(record, Channel):
-                        if record.id not in channels:
-                            channels[record.id] = writer.register_channel(
-                                record.topic,
-                                record.message_encoding,
-                                schemas[record.schema_id],
-                                dict(record.metadata),
-                            )
-                            topics[record.id] = record.topic
-                    elif isinstance(record, Message):
-                        writer.add_message(
-                            channels[record.channel_id],
-                            log_time=record.log_time,
-                            data=record.data,
-                            publish_time=record.publish_time,
-                            sequence=record.sequence,
-                        )
-                        _digest(digest, topics[record.channel_id], record)
-                        count += 1
-                    elif isinstance(record, Metadata):
-                        writer.add_metadata(record.name, dict(record.metadata))
-                    elif isinstance(record, Attachment):
-                        writer.add_attachment(
-                            record.create_time,
-                            record.log_time,
-                            record.name,
-                            record.media_type,
-                            record.data,
-                        )
+                    copy.add(record)
             except (*_UNREADABLE, KeyError) as err:
                 raise LogError(
                     f"{path} is damaged and was left as it was: {type(err).__name__}: {err}"
@@ -274,7 +236,55 @@ def _rewrite(path: Path, tmp: Path, chunk_size: int) -> tuple[int, str]:
             writer.finish()
             out.flush()
             os.fsync(out.fileno())
-    return count, digest.hexdigest()
+    return copy.count, copy.digest.hexdigest()
+
+
+class _Copy:
+    """The records of one MCAP file written again by ``writer``: schemas and channels under
+    the ids it gives them, and a count and digest of the messages copied."""
+
+    def __init__(self, writer: Writer) -> None:
+        self.writer = writer
+        self.schemas: dict[int, int] = {0: 0}  # the old id -> the new
+        self.channels: dict[int, int] = {}
+        self.topics: dict[int, str] = {}  # the old channel id -> its topic
+        self.count, self.digest = 0, hashlib.blake2b()
+
+    def add(self, record: object) -> None:
+        """Write ``record`` again (a KeyError where it names a schema or channel never seen)."""
+        writer = self.writer
+        if isinstance(record, Header):
+            writer.start(profile=record.profile, library=record.library)
+        elif isinstance(record, Schema):
+            if record.id not in self.schemas:
+                self.schemas[record.id] = writer.register_schema(
+                    record.name, record.encoding, record.data
+                )
+        elif isinstance(record, Channel):
+            if record.id not in self.channels:
+                self.channels[record.id] = writer.register_channel(
+                    record.topic,
+                    record.message_encoding,
+                    self.schemas[record.schema_id],
+                    dict(record.metadata),
+                )
+                self.topics[record.id] = record.topic
+        elif isinstance(record, Message):
+            writer.add_message(
+                self.channels[record.channel_id],
+                log_time=record.log_time,
+                data=record.data,
+                publish_time=record.publish_time,
+                sequence=record.sequence,
+            )
+            _digest(self.digest, self.topics[record.channel_id], record)
+            self.count += 1
+        elif isinstance(record, Metadata):
+            writer.add_metadata(record.name, dict(record.metadata))
+        elif isinstance(record, Attachment):
+            writer.add_attachment(
+                record.create_time, record.log_time, record.name, record.media_type, record.data
+            )
 
 
 def _verify(path: Path, tmp: Path, count: int, digest: str) -> None:

@@ -111,48 +111,78 @@ def replay_episode(
         if missing:
             raise ConfigError(f"the world has no aircraft {missing} that the log flew")
         _reset(world, episode)
-        logged = {c: (s.action, s.state) for c, s in episode.steps.items()}
-        seen = {team: episode.views(team) for team in world.team_slots} if world.external else {}
-        length = max(len(s) for s in episode.steps.values())
-        judged = [callsign] if callsign is not None else sorted(logged)
-        first: dict[str, int | None] = dict.fromkeys(judged)
-        worst = 0.0
-        for i in range(length):
-            actions: list[Controls | None] = []
-            for slot in world.slots:
-                flown = logged.get(slot.callsign)
-                if flown is None or i >= len(flown[0]):
-                    actions.append(None)
-                else:
-                    a0, a1, a2, a3 = flown[0][i].tolist()
-                    actions.append((a0, a1, a2, a3))
-            world.step_physics(actions)
-            for views in seen.values():  # what an online team saw of the others: its rewards
-                if i < len(views):
-                    _show(world, views[i])
-            world.score()
-            for c in judged:
-                states = logged[c][1]
-                if i >= len(states):
-                    continue
-                slot = world.by_callsign[c]
-                state, reward = slot.state, episode.steps[c].reward[i]
-                same = np.array_equal(state, states[i]) and slot.reward == reward
-                if first[c] is None and not same:
-                    first[c] = i
-                worst = max(worst, float(np.nanmax(np.abs(state - states[i]))))
-            if on_step is not None:
-                on_step(world, i)
+        judged = [callsign] if callsign is not None else sorted(episode.steps)
+        comparison = _Comparison(episode, judged)
+        length = _fly(world, episode, comparison, on_step)
     finally:
         if own:
             world.close()
             world.pool.close()
-    mismatches = [f for f in first.values() if f is not None]
-    return ReplayResult(
-        episode.index,
-        len(episode.steps[judged[0]]) if callsign is not None else length,
-        not mismatches,
-        worst,
-        min(mismatches) if mismatches else None,
-        {c: (f is None, f) for c, f in first.items()},
-    )
+    return comparison.result(len(episode.steps[judged[0]]) if callsign is not None else length)
+
+
+def _fly(
+    world: World,
+    episode: LoggedEpisode,
+    comparison: _Comparison,
+    on_step: Callable[[World, int], None] | None,
+) -> int:
+    """Fly every aircraft of ``world`` with its logged actions (none once its steps run
+    out), showing online teams what they saw, and compare each step; the steps flown."""
+    logged = {c: (s.action, s.state) for c, s in episode.steps.items()}
+    seen = {team: episode.views(team) for team in world.team_slots} if world.external else {}
+    length = max(len(s) for s in episode.steps.values())
+    for i in range(length):
+        actions: list[Controls | None] = []
+        for slot in world.slots:
+            flown = logged.get(slot.callsign)
+            if flown is None or i >= len(flown[0]):
+                actions.append(None)
+            else:
+                a0, a1, a2, a3 = flown[0][i].tolist()
+                actions.append((a0, a1, a2, a3))
+        world.step_physics(actions)
+        for views in seen.values():  # what an online team saw of the others: its rewards
+            if i < len(views):
+                _show(world, views[i])
+        world.score()
+        comparison.compare(world, i)
+        if on_step is not None:
+            on_step(world, i)
+    return length
+
+
+class _Comparison:
+    """The judged aircraft's re-flown states and rewards against the log's: each one's
+    first mismatching step and the largest state difference seen."""
+
+    def __init__(self, episode: LoggedEpisode, judged: list[str]) -> None:
+        self.episode = episode
+        self.first: dict[str, int | None] = dict.fromkeys(judged)
+        self.worst = 0.0
+
+    def compare(self, world: World, i: int) -> None:
+        """Compare step ``i`` of every judged aircraft that the log still holds."""
+        for c in self.first:
+            steps = self.episode.steps[c]
+            states = steps.state
+            if i >= len(states):
+                continue
+            slot = world.by_callsign[c]
+            state, reward = slot.state, steps.reward[i]
+            same = np.array_equal(state, states[i]) and slot.reward == reward
+            if self.first[c] is None and not same:
+                self.first[c] = i
+            self.worst = max(self.worst, float(np.nanmax(np.abs(state - states[i]))))
+
+    def result(self, steps: int) -> ReplayResult:
+        """The comparison of an episode of ``steps`` steps."""
+        mismatches = [f for f in self.first.values() if f is not None]
+        return ReplayResult(
+            self.episode.index,
+            steps,
+            not mismatches,
+            self.worst,
+            min(mismatches) if mismatches else None,
+            {c: (f is None, f) for c, f in self.first.items()},
+        )

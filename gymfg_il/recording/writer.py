@@ -48,6 +48,25 @@ def _start_record(s: Start) -> dict[str, Any]:
     return record
 
 
+def _register_schemas(w: Writer) -> dict[str, int]:
+    """Register the log's message schemas with ``w``, ours then Foxglove's 3D ones; their ids
+    by name."""
+    ours = {
+        "gymfg.Step": schemas.STEP,
+        "gymfg.EpisodeEvent": schemas.EPISODE_EVENT,
+        "gymfg.State": schemas.STATE,
+        "foxglove.LocationFix": schemas.LOCATION_FIX,
+        "gymfg.OpponentView": schemas.OPPONENT_VIEW,
+    }
+    ids = {
+        name: w.register_schema(name, "jsonschema", schemas.encoded(body))
+        for name, body in ours.items()
+    }
+    for name in ("foxglove.FrameTransform", "foxglove.SceneUpdate"):
+        ids[name] = w.register_schema(name, "jsonschema", schemas.encoded(fg.schema(name)))
+    return ids
+
+
 class TrajectoryWriter:
     """Write one session's MCAP log at ``path`` (an existing file is never overwritten).
 
@@ -86,46 +105,13 @@ class TrajectoryWriter:
             enable_data_crcs=True,  # a flip outside every chunk is found too
         )
         w.start(profile="", library="gymfg-il")
-
-        def schema(name: str, body: Mapping[str, object]) -> int:
-            return w.register_schema(name, "jsonschema", schemas.encoded(body))
-
-        step, event, state = (
-            schema("gymfg.Step", schemas.STEP),
-            schema("gymfg.EpisodeEvent", schemas.EPISODE_EVENT),
-            schema("gymfg.State", schemas.STATE),
-        )
-        fix, view = (
-            schema("foxglove.LocationFix", schemas.LOCATION_FIX),
-            schema("gymfg.OpponentView", schemas.OPPONENT_VIEW),
-        )
-        tf, scene = (
-            schema("foxglove.FrameTransform", fg.schema("foxglove.FrameTransform")),
-            schema("foxglove.SceneUpdate", fg.schema("foxglove.SceneUpdate")),
-        )
-        topics: dict[int, str] = {}
-
-        def channel(topic: str, schema_id: int) -> int:
-            topics[channel_id := w.register_channel(topic, "json", schema_id)] = topic
-            return channel_id
-
-        self._events = channel(EPISODE_TOPIC, event)
-        self._steps = {c: channel(aircraft_topic(c, "step"), step) for c in callsigns}
-        self._states = {c: channel(aircraft_topic(c, "state"), state) for c in callsigns}
-        self._fixes = {c: channel(aircraft_topic(c, "location"), fix) for c in callsigns}
-        self._tfs = {c: channel(aircraft_topic(c, "tf"), tf) for c in callsigns}
-        self._scenes = {c: channel(aircraft_topic(c, "scene"), scene) for c in callsigns}
+        topics = self._channels(callsigns, teams, bool(session.get("online")))
         self._look = {
             c: (a.get("model", ""), teams.index(a["team"])) for c, a in session["aircraft"].items()
         }
         self._frame = fg.LocalFrame(0.0, 0.0, 0.0)
         self._aims: dict[str, fg.Aim] = {}
         self._leads: dict[str, tuple[str, dict[str, Any]]] = {}  # callsign -> (task, plan)
-        self._views = (
-            {t: channel(view_topic(t), view) for t in teams}
-            if len(teams) > 1 or session.get("online")
-            else {}
-        )
         # Outside every chunk, each with its CRC: the session record twice and the channel
         # table, so that one damaged chunk or record never costs the whole log
         record = checked({k: json.dumps(v) for k, v in session.items()})
@@ -139,6 +125,37 @@ class TrajectoryWriter:
         self.episode = -1
         self._in_episode = False
         self._sync()
+
+    def _channels(self, callsigns: list[str], teams: list[str], online: bool) -> dict[int, str]:
+        """Register the log's schemas and channels: the episode events, each aircraft's step,
+        state, location, pose and scene, and each team's view where teams see others; the
+        topic of every channel by its id."""
+        w = self._writer
+        ids = _register_schemas(w)
+        topics: dict[int, str] = {}
+
+        def channel(topic: str, schema: str) -> int:
+            topics[channel_id := w.register_channel(topic, "json", ids[schema])] = topic
+            return channel_id
+
+        self._events = channel(EPISODE_TOPIC, "gymfg.EpisodeEvent")
+        self._steps = {c: channel(aircraft_topic(c, "step"), "gymfg.Step") for c in callsigns}
+        self._states = {c: channel(aircraft_topic(c, "state"), "gymfg.State") for c in callsigns}
+        self._fixes = {
+            c: channel(aircraft_topic(c, "location"), "foxglove.LocationFix") for c in callsigns
+        }
+        self._tfs = {
+            c: channel(aircraft_topic(c, "tf"), "foxglove.FrameTransform") for c in callsigns
+        }
+        self._scenes = {
+            c: channel(aircraft_topic(c, "scene"), "foxglove.SceneUpdate") for c in callsigns
+        }
+        self._views = (
+            {t: channel(view_topic(t), "gymfg.OpponentView") for t in teams}
+            if len(teams) > 1 or online
+            else {}
+        )
+        return topics
 
     def _sync(self) -> None:
         self._writer.flush()
@@ -306,6 +323,18 @@ class TrajectoryWriter:
             {"episode": self.episode, "step": step, **dict(zip(NAMES, values, strict=True))},
         )
         where, velocity = self._transform(callsign, values)
+        self._locate(callsign, values, velocity)
+        if callsign in self._leads:
+            self._place_lead(callsign, step)
+        aim = self._aims.get(callsign)
+        if aim is not None and aim.moved(observation):
+            entities = fg.target_entities(
+                self._clock_ns, callsign, aim.task, aim.value, where, self._frame
+            )
+            self._emit(self._scenes[callsign], {"deletions": [], "entities": entities})
+
+    def _locate(self, callsign: str, values: list[float], velocity: dict[str, float]) -> None:
+        """Log ``callsign``'s position as a Foxglove LocationFix (``values``: its state)."""
         self._emit(
             self._fixes[callsign],
             {
@@ -320,14 +349,6 @@ class TrajectoryWriter:
                 "velocity": velocity,
             },
         )
-        if callsign in self._leads:
-            self._place_lead(callsign, step)
-        aim = self._aims.get(callsign)
-        if aim is not None and aim.moved(observation):
-            entities = fg.target_entities(
-                self._clock_ns, callsign, aim.task, aim.value, where, self._frame
-            )
-            self._emit(self._scenes[callsign], {"deletions": [], "entities": entities})
 
     def log_view(self, team: str, step: int, view: OpponentView) -> None:
         """Log what ``team`` saw of the other teams after agent step ``step``."""
