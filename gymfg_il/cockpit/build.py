@@ -233,7 +233,7 @@ def _flight_log(
         source=source,
         pilot_name=named,
         realtime=realtime,
-        gusty=flight.turbulence != "none",
+        gusty=flight.gusty,
         error_at=list(env.observation_names).index(tracked["error"]) if tracked else None,
         throttle=env.aircraft.profile.cruise_throttle,
     )

@@ -196,7 +196,7 @@ def record_session(
     flown = iter_many(flight, pilot, seeds, workers, expert=expert, noise=noise)
     with TrajectoryWriter(new_log_path(out, source), record) as writer:
         for i, episode in enumerate(flown):
-            end = judged(episode, flight.turbulence != "none")
+            end = judged(episode, flight.gusty)
             writer.write_episode(episode, end, source=source, iteration=iteration)
             episodes.append(episode)
             if progress is not None:

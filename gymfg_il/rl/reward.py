@@ -86,7 +86,7 @@ class SuccessBonus(gym.Wrapper):
 
     def _judge(self) -> bool | None:
         flight = self._flight
-        gusty = flight.flight.turbulence != "none"
+        gusty = flight.flight.gusty
         errors = np.asarray(self._errors)
         success, _, _ = judge_flight(self._task, np.vstack(self._states), errors, flight.dt, gusty)
         return success
