@@ -98,6 +98,8 @@ def test_the_old_paths_are_the_ones_users_were_told_about():
         "gymfg_il.collectors.timing",
         "gymfg_il.collectors.updater",
         "gymfg_il.controllers.agent",
+        "gymfg_il.display.guidance",
+        "gymfg_il.display.instruments",
         "gymfg_il.manual.cockpit",
         "gymfg_il.rl.env",
         "gymfg_il.rl.forward",

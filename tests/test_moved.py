@@ -27,6 +27,8 @@ MOVED = {  # old module -> (new module, a name users import from it)
     "gymfg_il.collectors.manual_keys": ("gymfg_il.cockpit.inputs.keys", "help_lines"),
     "gymfg_il.collectors.timing": ("gymfg_il.cockpit.timing", "EpisodeTiming"),
     "gymfg_il.collectors.updater": ("gymfg_il.cockpit.updater", "DatasetUpdater"),
+    "gymfg_il.display.guidance": ("gymfg_il.tasks.guidance", "reading_names"),
+    "gymfg_il.display.instruments": ("gymfg_il.tasks.guidance", "PRIMARY"),
 }
 
 
@@ -49,6 +51,12 @@ def test_a_name_with_no_new_home_says_what_replaced_it():
     old = importlib.import_module("gymfg_il.collectors.synthetic")
     with pytest.raises(AttributeError, match=r"SyntheticDriver is gone: .*pilot='synthetic'"):
         old.SyntheticDriver  # noqa: B018
+
+
+def test_a_task_table_that_became_the_tasks_own_says_where_it_went():
+    old = importlib.import_module("gymfg_il.display.guidance")
+    with pytest.raises(AttributeError, match=r"APPROACH is gone: ApproachTask\.guidance"):
+        old.APPROACH  # noqa: B018
 
 
 def test_the_old_screenshot_command_runs_the_new_one_and_says_so():

@@ -21,8 +21,8 @@ import numpy as np
 
 from gymfg_il.controllers.autopilot import Autopilot, controller_for
 from gymfg_il.controllers.gains import Gains
-from gymfg_il.display.guidance import reading_names
 from gymfg_il.display.readings import Display
+from gymfg_il.tasks.guidance import reading_names
 from gymfg_il.units import DEG_TO_RAD, wrap_180
 
 # the rates the eye reads off the attitude indicator's motion: rate -> the reading it moves

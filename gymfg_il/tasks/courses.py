@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -17,6 +18,7 @@ from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.grades import Measure
+from gymfg_il.tasks.guidance import Line, ils_dots
 from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict, local_ft, size
 from gymfg_il.tasks.rewards import closeness
 from gymfg_il.tasks.scenery import Landmark
@@ -66,6 +68,24 @@ class WaypointsTask(ManeuverTask):
     tracked_entry = ("altitude_ft", "gate_altitude_error_ft", 150.0)
     radius_ft = 300.0
     altitude_tolerance_ft = 150.0
+    # the next gate's bearing and height as bugs, its distance, the gates left, the turn at it
+    guidance = (
+        Line("gate_bearing_deg", "deg", "heading", "bug", "bearing to the next gate"),
+        Line("gate_altitude_ft", "ft", "altitude", "bug", "height of the next gate"),
+        Line("gate_distance_ft", "ft", "panel", "guidance", "distance to the next gate"),
+        Line("gates_left", "1", "panel", "guidance", "gates left"),
+        Line("next_turn_deg", "deg", "panel", "guidance", "turn at the next gate"),
+    )
+
+    def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
+        o = observed
+        return [
+            wrap_360(o["heading_deg"] + o["gate_bearing_error_deg"]),
+            o["altitude_ft"] + o["gate_altitude_error_ft"],
+            o["gate_distance_ft"],
+            o["gates_left"],
+            o["next_turn_deg"],
+        ]
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
         profile = self._profile()
@@ -217,6 +237,34 @@ class ApproachTask(ManeuverTask):
     # the bank a stabilized final allows (the FAA's Airplane Flying Handbook: no more than
     # 15 deg on final); graded, never a success rule
     final_bank_deg = 15.0
+    # the runway course and the approach speed as bugs; localizer and glide-slope needles in
+    # dots; the distance to the threshold, the offsets in ft, the height above the threshold
+    guidance = (
+        Line("runway_course_deg", "deg", "heading", "bug", "runway course"),
+        Line("approach_kts", "kt", "airspeed", "bug", "approach speed"),
+        Line(
+            "localizer_dots", "dot", "localizer", "needle", "localizer (right of the centre line)"
+        ),
+        Line("glideslope_dots", "dot", "glideslope", "needle", "glide slope (below the path)"),
+        Line("distance_ft", "ft", "panel", "guidance", "to the threshold"),
+        Line("centerline_offset_ft", "ft", "panel", "guidance", "off the centre line"),
+        Line("glidepath_error_ft", "ft", "panel", "guidance", "off the glide path"),
+        Line("height_above_threshold_ft", "ft", "panel", "guidance", "height above the threshold"),
+    )
+
+    def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
+        o = observed
+        distance = o["distance_ft"]
+        needles = ils_dots(distance, o["centerline_offset_ft"], o["glidepath_error_ft"])
+        return [
+            wrap_360(o["heading_deg"] + o["course_error_deg"]),
+            o["airspeed_kts"] + o["airspeed_kts_error"],
+            *needles,
+            distance,
+            o["centerline_offset_ft"],
+            o["glidepath_error_ft"],
+            o["height_above_threshold_ft"],
+        ]
 
     @classmethod
     def flown_kts(cls, profile: FlightProfile) -> float:

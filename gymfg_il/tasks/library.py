@@ -21,12 +21,14 @@ it ``truncated``. The action is ``[aileron, elevator, rudder, throttle]``.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.guidance import bug
 from gymfg_il.tasks.paths import import_task
 from gymfg_il.tasks.rewards import RewardContext, action_change
 from gymfg_il.tasks.targets import (
@@ -187,6 +189,11 @@ class LevelFlightTask(Task):
     extra_names = ("altitude_ft_error", "heading_deg_error")
     altitude_tolerance = 50.0
     heading_tolerance = 3.0
+    # the start altitude and heading as bugs
+    guidance = (bug("altitude_ft_target", "altitude to hold"), bug("heading_deg_target", "heading"))
+
+    def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
+        return [self.start_altitude, self.start_heading]
 
     def _extra_bounds(self) -> tuple[list[float], list[float]]:
         return [-1e5, -180.0], [1e5, 180.0]

@@ -32,6 +32,7 @@ flown over the ground (waypoints, approach) and ``tasks.formation`` the formatio
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -41,6 +42,7 @@ from gymfg_il.aircraft import REFERENCE_PROFILE, FlightProfile
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
 from gymfg_il.tasks.grades import Measure, grade
+from gymfg_il.tasks.guidance import Line, bug
 from gymfg_il.tasks.rewards import RewardContext, action_change, closeness
 from gymfg_il.units import FT_PER_DEG, wrap_180, wrap_360
 
@@ -216,6 +218,17 @@ class TurnTask(ManeuverTask):
     tracked_entry = ("heading_deg", "turn_remaining_deg", 5.0)
     altitude_tolerance = 100.0
     heading_tolerance = 5.0
+    # the altitude and the new heading as bugs, the turn still to fly with its direction
+    guidance = (
+        bug("altitude_ft_target", "altitude to hold"),
+        bug("heading_deg_target", "new heading"),
+        Line("turn_remaining_deg", "deg", "panel", "guidance", "turn still to fly"),
+    )
+
+    def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
+        plan = self.plan
+        heading = wrap_360(plan["start_heading_deg"] + plan["turn_deg"])
+        return [plan["altitude_ft"], heading, observed["turn_remaining_deg"]]
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
         return {
@@ -296,6 +309,8 @@ class ClimbTurnTask(ManeuverTask):
     tracked_entry = ("altitude_ft", "altitude_ft_error", 50.0)
     altitude_tolerance = 50.0
     heading_tolerance = 3.0
+    # the new altitude and heading as bugs (the entries of the same names)
+    guidance = (bug("altitude_ft_target", "new altitude"), bug("heading_deg_target", "new heading"))
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
         return {

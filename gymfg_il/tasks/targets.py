@@ -20,6 +20,7 @@ import numpy as np
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import BY_NAME, INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.guidance import PRIMARY, Line, bug
 from gymfg_il.tasks.rewards import RewardContext, action_change
 from gymfg_il.units import wrap_180, wrap_360
 
@@ -209,6 +210,12 @@ class TargetTask(Task):
             err = wrap_180(err)
         smooth = action_change(ctx.prev_action, ctx.action)
         return math.exp(-abs(err) / self.reward_scale) - SMOOTHNESS_WEIGHT * smooth
+
+    def guidance_lines(self) -> tuple[Line, ...]:
+        """The target as a bug on its variable's instrument."""
+        instrument = PRIMARY[self.family.variable]
+        label = "target " + {"slip": "sideslip"}.get(instrument, instrument)
+        return (bug(f"{self.family.variable}_target", label),)
 
     def tracked(self) -> dict[str, Any]:
         v = self.family.variable
