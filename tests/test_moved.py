@@ -41,6 +41,23 @@ def test_an_old_path_gives_the_new_object_and_names_its_home(old):
     assert caught[0].filename == __file__  # it points at the line that used the old path
 
 
+NAMES = {  # (module that lives on, a name that moved out of it) -> its new home
+    ("gymfg_il.tasks.courses", "ApproachTask"): "gymfg_il.tasks.approach",
+    ("gymfg_il.tasks.scenery", "task_landmarks"): "gymfg_il.tasks.library",
+}
+
+
+@pytest.mark.parametrize(("old", "name"), sorted(NAMES))
+def test_a_name_that_moved_out_of_a_living_module_gives_the_new_object(old, name):
+    new = NAMES[old, name]
+    with pytest.warns(DeprecationWarning, match=f"{old}.{name} has moved to {new}") as caught:
+        value = getattr(importlib.import_module(old), name)
+    assert value is getattr(importlib.import_module(new), name)
+    assert caught[0].filename == __file__
+    with pytest.raises(AttributeError, match=f"module '{old}' has no attribute 'Nothing'"):
+        importlib.import_module(old).Nothing  # noqa: B018
+
+
 def test_a_name_the_new_home_lacks_is_an_attribute_error_naming_both():
     old = importlib.import_module("gymfg_il.viz.peers")
     with pytest.raises(AttributeError, match=r"gymfg_il\.viz\.peers.*gymfg_il\.flightgear\.peers"):

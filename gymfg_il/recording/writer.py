@@ -27,7 +27,7 @@ from gymfg_il.recording.schemas import EPISODE_TOPIC, aircraft_topic, view_topic
 from gymfg_il.recording.session import CHANNELS_METADATA, SESSION_COPY, SESSION_METADATA, checked
 from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
 from gymfg_il.sim.properties import ACTION_NAMES, INDEX, NAMES
-from gymfg_il.tasks.scenery import task_landmarks
+from gymfg_il.tasks.library import task_landmarks
 from gymfg_il.units import DEG_TO_RAD, FT_TO_M
 
 _INITIAL = ("lat_deg", "lon_deg", "altitude_ft")

@@ -31,6 +31,7 @@ from gymfg_il.tasks.base import FLIGHT_VARS, Task
 from gymfg_il.tasks.guidance import bug
 from gymfg_il.tasks.paths import import_task
 from gymfg_il.tasks.rewards import RewardContext, action_change
+from gymfg_il.tasks.scenery import Landmark, landmarks_of
 from gymfg_il.tasks.targets import (
     AIRSPEED,
     ALTITUDE,
@@ -250,7 +251,8 @@ TASK_FAMILIES: dict[str, tuple[type[Task], type[Task]]] = {
 
 def _add_maneuvers() -> tuple[str, ...]:
     """Register the maneuvers (they import this module's tasks); their names, in order."""
-    from gymfg_il.tasks.courses import ApproachTask, WaypointsTask
+    from gymfg_il.tasks.approach import ApproachTask
+    from gymfg_il.tasks.courses import WaypointsTask
     from gymfg_il.tasks.formation import FormationTask
     from gymfg_il.tasks.maneuvers import ClimbTurnTask, TurnTask
 
@@ -298,3 +300,18 @@ def task_reference(cls: type[Task]) -> tuple[str, bool]:
         if cls is moving:
             return family, True
     return f"{cls.__module__}:{cls.__qualname__}", False
+
+
+def task_landmarks(task: str, plan: dict[str, Any] | None, step: int) -> list[Landmark]:
+    """``tasks.scenery.landmarks_of`` for a task named as the library names it
+    (``waypoints``, ...); none for a task the library does not know (a user's own maneuver:
+    a recording or a video must not stop on its scenery)."""
+    from gymfg_il.errors import ConfigError
+
+    if not plan:
+        return []
+    try:
+        cls = task_class(task)
+    except ConfigError:
+        return []
+    return landmarks_of(cls, plan, step)
