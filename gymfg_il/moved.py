@@ -37,14 +37,19 @@ def forward(old: str, new: str, gone: Mapping[str, str] | None = None) -> Callab
     return __getattr__
 
 
-def forward_names(old: str, moved: Mapping[str, str]) -> Callable[[str], Any]:
+def forward_names(
+    old: str, moved: Mapping[str, str], gone: Mapping[str, str] | None = None
+) -> Callable[[str], Any]:
     """The module ``__getattr__`` of ``old``, a module that still lives but some of whose
     names moved: each name of ``moved`` comes from the module it maps to, with a
-    DeprecationWarning pointing at the line that used the old path; any other name it lacks
-    is an AttributeError, as without this. (The new home is imported when the name is first
-    asked for, so a name moved below a module does not tie the two together.)"""
+    DeprecationWarning pointing at the line that used the old path; ``gone``: names that
+    have no new home, each with what replaced it (the AttributeError says so); any other
+    name it lacks is an AttributeError, as without this. (The new home is imported when the
+    name is first asked for, so a name moved below a module does not tie the two together.)"""
 
     def __getattr__(name: str) -> Any:
+        if gone and name in gone:
+            raise AttributeError(f"{old}.{name} is gone: {gone[name]}")
         if name not in moved:
             raise AttributeError(f"module {old!r} has no attribute {name!r}")
         new = moved[name]

@@ -58,6 +58,19 @@ def test_a_name_that_moved_out_of_a_living_module_gives_the_new_object(old, name
         importlib.import_module(old).Nothing  # noqa: B018
 
 
+GONE = {  # (module that lives on, a table each task now declares itself) -> what says it
+    ("gymfg_il.controllers.autopilot", "MANEUVER_TARGETS"): "expert_targets",
+    ("gymfg_il.controllers.autopilot", "scaled_for"): r"ManeuverTask\.expert\(\)",
+    ("gymfg_il.manual.perception", "DISPLAY_SOURCES"): r"Task\.expert\(\)\.on_display",
+}
+
+
+@pytest.mark.parametrize(("old", "name"), sorted(GONE))
+def test_a_table_a_task_now_declares_says_where_its_knowledge_went(old, name):
+    with pytest.raises(AttributeError, match=f"{old}.{name} is gone: .*{GONE[old, name]}"):
+        getattr(importlib.import_module(old), name)
+
+
 def test_a_name_the_new_home_lacks_is_an_attribute_error_naming_both():
     old = importlib.import_module("gymfg_il.viz.peers")
     with pytest.raises(AttributeError, match=r"gymfg_il\.viz\.peers.*gymfg_il\.flightgear\.peers"):

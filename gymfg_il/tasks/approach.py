@@ -9,13 +9,14 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from gymfg_il.aircraft import FlightProfile
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX
+from gymfg_il.tasks.experts import Targets
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.grades import Measure
 from gymfg_il.tasks.guidance import Line, ils_dots
@@ -99,6 +100,21 @@ class ApproachTask(ManeuverTask):
         Line("glidepath_error_ft", "ft", "panel", "guidance", "off the glide path"),
         Line("height_above_threshold_ft", "ft", "panel", "guidance", "height above the threshold"),
     )
+
+    expert_targets = Targets(
+        vertical_source="glidepath_error_ft",
+        lateral="track",
+        lateral_source="course_error_deg",
+        track_source="centerline_offset_ft",
+        track_gain=0.03,
+        speed_source="airspeed_kts_error",
+        relative=frozenset({"vertical", "lateral", "speed"}),
+    )
+    expert_on_display: ClassVar[Mapping[str, Any]] = {
+        "lateral_source": "runway_course_deg",
+        "speed_source": "approach_kts",
+        "relative": frozenset({"vertical"}),
+    }
 
     def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
         o = observed

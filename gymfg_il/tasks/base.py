@@ -5,8 +5,10 @@ team roster). Subclasses set ``observation_vars`` and override ``reward`` (or an
 reward without a subclass is one lambda: ``DummyTask(reward=lambda ctx: ...)``.
 
 A task also owns what the rest of the toolkit knows of it: what the window shows a pilot of
-it (``guidance_lines``, ``guidance_values``: ``tasks.guidance``) and which target it brings
-within which tolerance (``tracked``: the verdict's, ``tasks.verdicts``).
+it (``guidance_lines``, ``guidance_values``: ``tasks.guidance``), which target it brings
+within which tolerance (``tracked``: the verdict's, ``tasks.verdicts``), and the structure of
+its expert (``expert``: ``tasks.experts``), which the controllers and the synthetic pilot
+build their loops from.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from gymfg_il.aircraft import Aircraft, FlightProfile
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import BY_NAME, INDEX, indices
+from gymfg_il.tasks.experts import Expert
 from gymfg_il.tasks.guidance import Line, target_bugs
 from gymfg_il.tasks.rewards import RewardContext, RewardFn
 
@@ -228,6 +231,11 @@ class Task:
         """The values of ``guidance_lines()`` from this step's observation (by name); by
         default the observed entries of the same names."""
         return [observed[line.name] for line in self.guidance_lines()]
+
+    def expert(self) -> Expert | None:
+        """The structure of the expert that flies this task (``tasks.experts``), which
+        ``controllers.autopilot.controller_for`` builds; None: the task has none."""
+        return None
 
     def describe(self) -> dict[str, Any]:
         """What the task is, for logs and dataset metadata."""

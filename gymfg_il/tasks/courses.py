@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from gymfg_il.moved import forward_names
 from gymfg_il.sim.properties import INDEX
+from gymfg_il.tasks.experts import Targets
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.grades import Measure
 from gymfg_il.tasks.guidance import Line
@@ -76,6 +77,18 @@ class WaypointsTask(ManeuverTask):
         Line("gates_left", "1", "panel", "guidance", "gates left"),
         Line("next_turn_deg", "deg", "panel", "guidance", "turn at the next gate"),
     )
+
+    expert_targets = Targets(
+        vertical_source="gate_altitude_error_ft",
+        lateral="heading",
+        lateral_source="gate_bearing_error_deg",
+        relative=frozenset({"vertical", "lateral"}),
+    )
+    expert_on_display: ClassVar[Mapping[str, Any]] = {
+        "vertical_source": "gate_altitude_ft",
+        "lateral_source": "gate_bearing_deg",
+        "relative": frozenset(),
+    }
 
     def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
         o = observed

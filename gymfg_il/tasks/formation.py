@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from gymfg_il.aircraft import REFERENCE_PROFILE
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX, indices
+from gymfg_il.tasks.experts import Targets
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.grades import Measure
 from gymfg_il.tasks.guidance import Line
@@ -127,6 +128,21 @@ class FormationTask(ManeuverTask):
         Line("below_slot_ft", "ft", "slot", "guidance", "off the slot, height"),
         Line("behind_slot_rate_fps", "ft/s", "slot", "guidance", "closure"),
     )
+
+    expert_targets = Targets(
+        vertical_source="below_slot_ft",
+        lateral="track",
+        lateral_source="lead_heading_error_deg",
+        track_source="right_of_slot_ft",
+        track_gain=0.2,
+        station_source="behind_slot_ft",
+        station_rate_source="behind_slot_rate_fps",
+        relative=frozenset({"vertical", "lateral"}),
+    )
+    expert_on_display: ClassVar[Mapping[str, Any]] = {
+        "lateral_source": "lead_heading_deg",
+        "relative": frozenset({"vertical"}),
+    }
 
     def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
         o = observed

@@ -28,6 +28,7 @@ import numpy as np
 
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.experts import Expert, Targets
 from gymfg_il.tasks.guidance import bug
 from gymfg_il.tasks.paths import import_task
 from gymfg_il.tasks.rewards import RewardContext, action_change
@@ -55,6 +56,10 @@ class DummyTask(Task):
     """
 
     name = "dummy"
+
+    def expert(self) -> Expert:
+        """The autopilot holding what it had: altitude, wings level, airspeed."""
+        return Expert()
 
 
 _TARGET_DOC = """
@@ -195,6 +200,17 @@ class LevelFlightTask(Task):
 
     def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
         return [self.start_altitude, self.start_heading]
+
+    def expert(self) -> Expert:
+        """Hold the start altitude and heading (read off their bugs on the window)."""
+        return Expert(
+            Targets(lateral="heading", lateral_source=None),
+            on_display={
+                "vertical_source": "altitude_ft_target",
+                "lateral_source": "heading_deg_target",
+                "relative": frozenset(),
+            },
+        )
 
     def _extra_bounds(self) -> tuple[list[float], list[float]]:
         return [-1e5, -180.0], [1e5, 180.0]
