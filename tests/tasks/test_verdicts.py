@@ -35,7 +35,8 @@ def flown(task, seed, aircraft="c172p", episode_time_s=30.0, **options):
 
 @pytest.mark.parametrize(("task", "turbulence"), [("altitude", "none"), ("turn", "light")])
 def test_step_by_step_and_all_at_once_give_one_verdict(task, turbulence):
-    _, episode, verdict = flown(task, 61, turbulence=turbulence)
+    env, episode, verdict = flown(task, 61, turbulence=turbulence)
+    assert env.flight.gusty == verdict.gusty == (turbulence == "light")
     t = episode.solo
     states = np.vstack([t.start.state[None], t.states])
     at_once = EpisodeVerdict.flown(
@@ -43,7 +44,7 @@ def test_step_by_step_and_all_at_once_give_one_verdict(task, turbulence):
         states,
         verdict.tracked.column(t.next_observations),
         episode.dt,
-        turbulence != "none",
+        env.flight.gusty,
     )
     assert np.array_equal(at_once.states, verdict.states) and verdict.steps == len(t.states)
     assert np.allclose(at_once.errors, verdict.errors)
