@@ -27,6 +27,8 @@ MOVED = {  # old module -> (new module, a name users import from it)
     "gymfg_il.collectors.manual_keys": ("gymfg_il.cockpit.inputs.keys", "help_lines"),
     "gymfg_il.collectors.timing": ("gymfg_il.cockpit.timing", "EpisodeTiming"),
     "gymfg_il.collectors.updater": ("gymfg_il.cockpit.updater", "DatasetUpdater"),
+    "gymfg_il.display.guidance": ("gymfg_il.tasks.guidance", "reading_names"),
+    "gymfg_il.display.instruments": ("gymfg_il.tasks.guidance", "PRIMARY"),
 }
 
 
@@ -39,6 +41,36 @@ def test_an_old_path_gives_the_new_object_and_names_its_home(old):
     assert caught[0].filename == __file__  # it points at the line that used the old path
 
 
+NAMES = {  # (module that lives on, a name that moved out of it) -> its new home
+    ("gymfg_il.tasks.courses", "ApproachTask"): "gymfg_il.tasks.approach",
+    ("gymfg_il.tasks.scenery", "task_landmarks"): "gymfg_il.tasks.library",
+}
+
+
+@pytest.mark.parametrize(("old", "name"), sorted(NAMES))
+def test_a_name_that_moved_out_of_a_living_module_gives_the_new_object(old, name):
+    new = NAMES[old, name]
+    with pytest.warns(DeprecationWarning, match=f"{old}.{name} has moved to {new}") as caught:
+        value = getattr(importlib.import_module(old), name)
+    assert value is getattr(importlib.import_module(new), name)
+    assert caught[0].filename == __file__
+    with pytest.raises(AttributeError, match=f"module '{old}' has no attribute 'Nothing'"):
+        importlib.import_module(old).Nothing  # noqa: B018
+
+
+GONE = {  # (module that lives on, a table each task now declares itself) -> what says it
+    ("gymfg_il.controllers.autopilot", "MANEUVER_TARGETS"): "expert_targets",
+    ("gymfg_il.controllers.autopilot", "scaled_for"): r"ManeuverTask\.expert\(\)",
+    ("gymfg_il.manual.perception", "DISPLAY_SOURCES"): r"Task\.expert\(\)\.on_display",
+}
+
+
+@pytest.mark.parametrize(("old", "name"), sorted(GONE))
+def test_a_table_a_task_now_declares_says_where_its_knowledge_went(old, name):
+    with pytest.raises(AttributeError, match=f"{old}.{name} is gone: .*{GONE[old, name]}"):
+        getattr(importlib.import_module(old), name)
+
+
 def test_a_name_the_new_home_lacks_is_an_attribute_error_naming_both():
     old = importlib.import_module("gymfg_il.viz.peers")
     with pytest.raises(AttributeError, match=r"gymfg_il\.viz\.peers.*gymfg_il\.flightgear\.peers"):
@@ -49,6 +81,12 @@ def test_a_name_with_no_new_home_says_what_replaced_it():
     old = importlib.import_module("gymfg_il.collectors.synthetic")
     with pytest.raises(AttributeError, match=r"SyntheticDriver is gone: .*pilot='synthetic'"):
         old.SyntheticDriver  # noqa: B018
+
+
+def test_a_task_table_that_became_the_tasks_own_says_where_it_went():
+    old = importlib.import_module("gymfg_il.display.guidance")
+    with pytest.raises(AttributeError, match=r"APPROACH is gone: ApproachTask\.guidance"):
+        old.APPROACH  # noqa: B018
 
 
 def test_the_old_screenshot_command_runs_the_new_one_and_says_so():

@@ -45,6 +45,7 @@ from gymfg_il.manual.takeover import Takeover
 from gymfg_il.recording.session import session_record
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.loop import Rollout
+from gymfg_il.tasks.verdicts import TrackedError
 from gymfg_il.viz.camera import Camera
 
 
@@ -179,11 +180,8 @@ def _input(
         human.joy,
         human.window_size,
     )
-    tracked = env.task.tracked()
-    gated = None
-    if tracked:  # the DAgger gate reads the task's tracked error against its tolerance
-        at = list(env.observation_names).index(tracked["error"])
-        gated = (at, float(tracked.get("tolerance", 0.0)))
+    # the DAgger gate reads the task's tracked error against its tolerance
+    gated = TrackedError.of(env.task.describe())
     return SyntheticInput(devices, pilot, assisted=assisted, tracked=gated)
 
 
@@ -224,7 +222,6 @@ def _flight_log(
     named = config.pilot_name
     if named is None:
         named = f"synthetic-{config.skill:g}" if config.pilot == "synthetic" else ""
-    tracked = env.task.tracked()
     return FlightLog(
         config.out,
         record,
@@ -233,7 +230,6 @@ def _flight_log(
         source=source,
         pilot_name=named,
         realtime=realtime,
-        gusty=flight.turbulence != "none",
-        error_at=list(env.observation_names).index(tracked["error"]) if tracked else None,
+        gusty=flight.gusty,
         throttle=env.aircraft.profile.cruise_throttle,
     )

@@ -17,10 +17,11 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.cockpit.timing import WARN_S, EpisodeTiming
-from gymfg_il.display.briefing import Debrief, debrief
+from gymfg_il.display.briefing import Debrief, debrief_of
 from gymfg_il.recording.recorder import new_log_path
 from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.records import Start, Tick
+from gymfg_il.tasks.verdicts import EpisodeVerdict
 
 
 class FlightLog:
@@ -30,13 +31,12 @@ class FlightLog:
         out: the session folder; the log is opened in its ``logs/`` when the first episode
             starts (a session quit before flying leaves no log).
         record: the log's session record (``recording.session.session_record``).
-        task: the bound task, which judges each episode.
+        task: the bound task, which judges each episode (``tasks.verdicts.EpisodeVerdict``).
         dt: seconds per agent step.
         source: who flies (``human``, ``synthetic``, ``controller+human``, ...).
         pilot_name: the pilot's name stored with each episode ("" for none).
         realtime: keep the wall clock and the timing (a person's session).
         gusty: the flight is in turbulence (the task's verdict allows for it).
-        error_at: index of the task's tracked error in the observation (None: no target).
         throttle: the throttle of ``last_action`` before the first step.
     """
 
@@ -51,19 +51,17 @@ class FlightLog:
         pilot_name: str,
         realtime: bool,
         gusty: bool,
-        error_at: int | None,
         throttle: float,
     ) -> None:
         self.out, self.record, self.task, self.dt = out, record, task, dt
         self.source, self.pilot_name, self.realtime = source, pilot_name, realtime
-        self.gusty, self.error_at = gusty, error_at
+        self.gusty = gusty
         self.writer: TrajectoryWriter | None = None
         self.last_action = np.array([0.0, 0.0, 0.0, throttle])  # what was flown last
         self.debrief: Debrief | None = None  # the last episode's verdict
         self.timing = EpisodeTiming(dt)
         self.steps = self.interventions = 0
-        self._flown: list[np.ndarray] = []  # this episode's states, the reset's first
-        self._errors: list[float] = []
+        self.verdict: EpisodeVerdict | None = None  # what this episode flew
         self._return = 0.0
         self._late_at = -math.inf  # when a frame last came late
 
@@ -74,7 +72,9 @@ class FlightLog:
 
     def start(self, seed: int, starts: list[Start]) -> None:
         """An episode begins (the rollout was just reset with ``seed``)."""
-        self._flown, self._errors, self._return = [starts[0].state.copy()], [], 0.0
+        self.verdict = EpisodeVerdict.of(self.task, self.dt, self.gusty)  # its plan now drawn
+        self.verdict.start(starts[0].state)
+        self._return = 0.0
         self.debrief = None
         self.steps = self.interventions = 0
         self.timing = EpisodeTiming(self.dt)
@@ -89,10 +89,9 @@ class FlightLog:
         self._writer().log_tick(tick, read_at if self.realtime else None)
         (step,) = tick.steps
         self.last_action = step.action
-        self._flown.append(step.state.copy())
+        assert self.verdict is not None  # start() came first
+        self.verdict.add(step.state, observation)
         self._return += step.reward
-        if self.error_at is not None:
-            self._errors.append(float(observation[self.error_at]))
         self.steps += 1
         self.interventions += int(step.intervention)
         if self.realtime and period is not None and self.timing.add(period):
@@ -104,10 +103,8 @@ class FlightLog:
     def finish(self, outcome: str) -> int:
         """Judge and end the episode; its number in the log (what a mark marks)."""
         writer = self._writer()
-        states, errors = np.array(self._flown), np.array(self._errors)
-        self.debrief = judged = debrief(
-            self.task, states, errors, self.dt, outcome, self._return, self.gusty
-        )
+        assert self.verdict is not None
+        self.debrief = judged = debrief_of(self.verdict, outcome, self._return)
         writer.end_episode(
             outcome=outcome,
             steps=self.steps,

@@ -28,7 +28,7 @@ from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.records import Episode
 from gymfg_il.rollout.seeded import iter_many
-from gymfg_il.tasks.verdicts import judge_flight
+from gymfg_il.tasks.verdicts import EpisodeVerdict, TrackedError
 from gymfg_il.workers import Workers
 
 DATASET = "dataset"
@@ -147,24 +147,20 @@ class SessionResult:
 
 def judged(episode: Episode, gusty: bool) -> dict[str, Any]:
     """A one-aircraft episode's verdict and grade as its end event stores them
-    (``tasks.verdicts.judge_flight``; nothing where it is not judged: a team's episode)."""
-    from gymfg_il.tasks.grades import grade
-
+    (``tasks.verdicts.EpisodeVerdict``; nothing where it is not judged: a team's episode, a
+    maneuver whose judge the library cannot find)."""
     if len(episode.trajectories) != 1:
         return {}
     t = episode.solo
     task = t.start.task
-    if t.terminated:
-        return {"success": False, "verdict": episode.outcome, "grade": grade(False, ())}
     states = np.vstack([t.start.state[None], t.states])
-    tracked = task.get("tracked") or {}
-    names = list(task.get("observation", []))
-    at = names.index(tracked["error"]) if tracked.get("error") in names else None
-    errors = t.next_observations[:, at] if at is not None else np.zeros(0)
-    success, detail, measures = judge_flight(task, states, errors, episode.dt, gusty)
-    if success is None:
+    tracked = TrackedError.of(task)
+    errors = tracked.column(t.next_observations) if tracked is not None else np.zeros(0)
+    verdict = EpisodeVerdict.flown(task, states, errors, episode.dt, gusty)
+    found = verdict.judge(episode.outcome if t.terminated else None)
+    if found is None:
         return {}
-    return {"success": success, "verdict": detail, "grade": grade(success, measures)}
+    return {"success": found.success, "verdict": found.detail, "grade": found.grade}
 
 
 def record_session(
@@ -196,7 +192,7 @@ def record_session(
     flown = iter_many(flight, pilot, seeds, workers, expert=expert, noise=noise)
     with TrajectoryWriter(new_log_path(out, source), record) as writer:
         for i, episode in enumerate(flown):
-            end = judged(episode, flight.turbulence != "none")
+            end = judged(episode, flight.gusty)
             writer.write_episode(episode, end, source=source, iteration=iteration)
             episodes.append(episode)
             if progress is not None:

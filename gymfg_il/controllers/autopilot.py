@@ -10,56 +10,27 @@ Loops (each a ``PID`` with explicit ``dt``):
 | rudder | sideslip -> 0 (coordinated flight), or to a target (a slip) | |
 
 ``Autopilot`` holds one target per axis (vertical: altitude, climb rate or pitch; lateral: roll
-or heading; speed: airspeed). Axes left without a target hold what they had at the first
-observation of the episode (altitude, wings level, airspeed), so every task's controller
-flies a complete aircraft. ``controller_for(task)`` builds the one that matches a task.
+or heading; speed: airspeed), where ``Targets`` (``tasks.experts``) says. Axes left without a
+target hold what they had at the first observation of the episode (altitude, wings level,
+airspeed), so every task's controller flies a complete aircraft. ``controller_for(task)``
+builds the one a task declares (``Task.expert()``).
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass, replace
 
 import numpy as np
 
 from gymfg_il.controllers.gains import Gains, gains_for, maneuver_gains
 from gymfg_il.controllers.pid import PID
 from gymfg_il.errors import ConfigError
+from gymfg_il.moved import forward_names
+from gymfg_il.tasks.experts import Targets
 from gymfg_il.tasks.orientation import bank_for_turn_rate
 from gymfg_il.units import RAD_TO_DEG, wrap_180
 
 # a heading target turning faster than this jumped (a new target): no turn feed-forward
 MAX_FEED_FORWARD_TURN_DEG_S = 10.0
-
-
-@dataclass(frozen=True)
-class Targets:
-    """Where each target comes from: an observation name, a constant, or None (hold start).
-
-    ``relative``: names the axes (``vertical``, ``lateral``, ``speed``) whose source entry
-    holds the error (target minus value, wrapped for headings) instead of the target itself.
-    ``lateral="track"`` steers onto a line (a runway centre line, a slot beside a lead): the
-    source holds the line's course minus the heading and ``track_source`` how far right of
-    the line the aircraft is (ft); the heading target is the course turned towards the line
-    by ``track_gain`` degrees per ft, at most ``track_limit_deg``.
-    ``station_source`` keeps station on a moving point (a formation slot): it holds how far
-    behind the point the aircraft is (ft) and ``station_rate_source`` how fast that grows
-    (ft/s); the airspeed target is the airspeed plus ``station_gains`` (kt per ft, kt per
-    ft/s) times them, at most 20 kt either way.
-    """
-
-    vertical: str = "altitude"  # "altitude", "pitch" or "climb"
-    vertical_source: str | float | None = None
-    lateral: str = "roll"  # "roll", "heading" or "track"
-    lateral_source: str | float | None = 0.0
-    speed_source: str | float | None = None
-    sideslip_source: str | float | None = None  # None: coordinated flight (zero sideslip)
-    relative: frozenset[str] = frozenset()
-    track_source: str | None = None
-    track_gain: float = 0.02
-    track_limit_deg: float = 30.0
-    station_source: str | None = None
-    station_rate_source: str | None = None
-    station_gains: tuple[float, float] = (0.4, 2.0)
+HOLD_START = Targets()  # every axis holds what it had at the episode's first observation
 
 
 class Autopilot:
@@ -78,7 +49,7 @@ class Autopilot:
         observation_names: tuple[str, ...],
         model: str,
         dt: float,
-        targets: Targets = Targets(),
+        targets: Targets = HOLD_START,
         gains: Gains | None = None,
     ) -> None:
         if not dt > 0:
@@ -264,89 +235,32 @@ class Autopilot:
         return np.array([aileron, -nose_up, rudder, throttle])
 
 
-_BOTH = frozenset({"vertical", "lateral"})
-# The experts of the maneuvers (``tasks.maneuvers``, ``tasks.courses``): the same loops, fed
-# from the entries each maneuver observes.
-MANEUVER_TARGETS: dict[str, Targets] = {
-    "turn": Targets(
-        vertical_source="altitude_ft_error",
-        lateral="heading",
-        lateral_source="turn_remaining_deg",
-        relative=_BOTH,
-    ),
-    "climb-turn": Targets(
-        vertical_source="altitude_ft_target", lateral="heading", lateral_source="heading_deg_target"
-    ),
-    "waypoints": Targets(
-        vertical_source="gate_altitude_error_ft",
-        lateral="heading",
-        lateral_source="gate_bearing_error_deg",
-        relative=_BOTH,
-    ),
-    "approach": Targets(
-        vertical_source="glidepath_error_ft",
-        lateral="track",
-        lateral_source="course_error_deg",
-        track_source="centerline_offset_ft",
-        track_gain=0.03,
-        speed_source="airspeed_kts_error",
-        relative=_BOTH | {"speed"},
-    ),
-    "formation": Targets(
-        vertical_source="below_slot_ft",
-        lateral="track",
-        lateral_source="lead_heading_error_deg",
-        track_source="right_of_slot_ft",
-        track_gain=0.2,
-        station_source="behind_slot_ft",
-        station_rate_source="behind_slot_rate_fps",
-        relative=_BOTH,
-    ),
-}
-
-
-def scaled_for(task: object, targets: Targets, model: str) -> tuple[Targets, Gains]:
-    """A maneuver's targets and gains on its aircraft (a bound task): the maneuver gains
-    (``gains.maneuver_gains``) banked at its profile's ``bank_deg``, the track gain divided
-    by the task's ``speed_scale`` (a line closed in the same seconds whatever the speed).
-    Unchanged on the c172p."""
-    profile = task.aircraft.profile  # type: ignore[attr-defined]
-    scale = task.speed_scale()  # type: ignore[attr-defined]
-    targets = replace(targets, track_gain=targets.track_gain / scale)
-    return targets, maneuver_gains(model, profile.bank_deg)
-
-
 def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0.7) -> Autopilot:
-    """The autopilot that flies ``task`` (a bound Task): its target on the task's axis, the
-    other axes held at their start values."""
-    from gymfg_il.tasks.library import DummyTask, LevelFlightTask
-    from gymfg_il.tasks.targets import TargetTask
-
+    """The autopilot that flies ``task`` (a bound Task) as the task declares its expert
+    (``Task.expert()``, ``tasks.experts``): which target each loop follows, the other axes
+    held at their start values, and the gain set (the aircraft's own, or the maneuver gains
+    banked at most the expert's ``bank_deg``)."""
+    declared = getattr(task, "expert", None)
+    expert = declared() if callable(declared) else None
+    if expert is None:
+        raise ConfigError(
+            f"no controller for {type(task).__name__}: declare its expert (Task.expert(), "
+            "gymfg_il.tasks.experts) or build an Autopilot yourself"
+        )
+    gains = None if expert.bank_deg is None else maneuver_gains(model, expert.bank_deg)
     names = task.observation_names  # type: ignore[attr-defined]
-    gains = None
-    if isinstance(task, TargetTask):
-        var = task.family.variable
-        source = f"{var}_target"
-        key = task.family.key
-        targets = {
-            "altitude": Targets(vertical="altitude", vertical_source=source),
-            "pitch": Targets(vertical="pitch", vertical_source=source),
-            "roll": Targets(lateral="roll", lateral_source=source),
-            "heading": Targets(lateral="heading", lateral_source=source),
-            "airspeed": Targets(speed_source=source),
-            "sideslip": Targets(sideslip_source=source),
-        }[key]
-    elif getattr(task, "name", None) in MANEUVER_TARGETS:
-        targets = MANEUVER_TARGETS[task.name]  # type: ignore[attr-defined]
-        aircraft = getattr(task, "aircraft", None)
-        if aircraft is not None:  # flown as its aircraft's pilot would (``scaled_for``)
-            targets, gains = scaled_for(task, targets, model)
-    elif isinstance(task, LevelFlightTask):
-        targets = Targets(lateral="heading", lateral_source=None)
-    elif isinstance(task, DummyTask):
-        targets = Targets()
-    else:
-        raise ConfigError(f"no controller for {type(task).__name__}; build an Autopilot yourself")
-    pilot = Autopilot(names, model, dt, targets, gains)
+    pilot = Autopilot(names, model, dt, expert.targets, gains)
     pilot.set_throttle_trim(throttle_trim)
     return pilot
+
+
+# names whose knowledge each task now declares itself
+__getattr__ = forward_names(
+    __name__,
+    {},
+    gone={
+        "MANEUVER_TARGETS": "each maneuver declares its expert's loops (TurnTask.expert_targets, "
+        "...; any task: Task.expert(), gymfg_il.tasks.experts)",
+        "scaled_for": "ManeuverTask.expert() scales a maneuver's expert for its aircraft",
+    },
+)

@@ -12,13 +12,14 @@ import dataclasses
 import numpy as np
 
 from gymfg_il.aircraft import Aircraft
-from gymfg_il.controllers.autopilot import Autopilot, Targets
+from gymfg_il.controllers.autopilot import Autopilot
 from gymfg_il.controllers.gains import maneuver_gains
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import ACTION_HIGH, ACTION_LOW, indices
 from gymfg_il.sim.simulation import Simulation
 from gymfg_il.sim.timing import DEFAULT_SIM_HZ
 from gymfg_il.tasks.base import FLIGHT_VARS
+from gymfg_il.tasks.experts import Targets
 
 OWN = (*FLIGHT_VARS, "heading_deg")
 _NAMES = (*OWN, "altitude_ft_target", "heading_deg_target")

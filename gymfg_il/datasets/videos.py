@@ -28,7 +28,8 @@ import numpy as np
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.reader import Log, LoggedEpisode
-from gymfg_il.tasks.scenery import Landmark, aircraft_landmark, task_landmarks
+from gymfg_il.tasks.library import task_landmarks
+from gymfg_il.tasks.scenery import Landmark, aircraft_landmark
 from gymfg_il.viz.camera import VIEWS, Camera
 
 IMAGE_PREFIX = "observation.images."

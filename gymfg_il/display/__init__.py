@@ -1,2 +1,3 @@
-"""What a person at the window is given: the display model (``readings``), each task's
-targets and guidance (``guidance``), and the briefing and debrief (``briefing``)."""
+"""What a person at the window is given: the display model (``readings``: the instruments,
+and each task's targets and guidance as the task declares them, ``tasks.guidance``), and the
+briefing and debrief (``briefing``)."""

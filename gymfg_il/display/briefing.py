@@ -6,8 +6,9 @@ rule of ``tasks.verdicts``), what grades it (the ``Grade:`` sentence, with the s
 ``tasks.grades``) and the time. Nothing is written twice: change a task's docstring
 and the briefing follows.
 
-The debrief gives the task's verdict on the flown states (``ManeuverTask.judge``, or the
-target rule), its grade (``tasks.grades``), why it ended, the return and the main error.
+The debrief gives the task's verdict on the flown episode (``tasks.verdicts.EpisodeVerdict``:
+a maneuver's judge, or the target rule), its grade (``tasks.grades``), why it ended, the
+return and the main error.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import numpy as np
 
 from gymfg_il.sim.properties import BY_NAME
 from gymfg_il.tasks.grades import GRADES, SHARES, Measure, grade, said
-from gymfg_il.tasks.verdicts import HOLD_S, allowed_error, judge_flight
+from gymfg_il.tasks.verdicts import HOLD_S, EpisodeVerdict, allowed_error
 
 WIDTH = 84  # characters per line of the window's text panel
 
@@ -82,20 +83,25 @@ def debrief(
     total_return: float,
     gusty: bool = False,
 ) -> Debrief:
-    """Judge an episode as evaluation does: ``states`` (catalogue order, the reset state
-    first) for a maneuver's judge, ``errors`` (the tracked error entry of each step's
-    observation) for the target rule; ``ended`` says why it ended (``time limit``,
-    ``crashed``, ``ended by the pilot``)."""
+    """``debrief_of`` the episode the bound ``task`` has just flown, given as arrays:
+    ``states`` (catalogue order, the reset state first) and ``errors`` (the tracked error
+    entry of each step's observation)."""
+    judge = getattr(task, "judge", None)
+    verdict = EpisodeVerdict.flown(task.describe(), states, errors, dt, gusty, judge)
+    return debrief_of(verdict, ended, total_return)
+
+
+def debrief_of(verdict: EpisodeVerdict, ended: str, total_return: float) -> Debrief:
+    """Judge an episode as evaluation does (``tasks.verdicts.EpisodeVerdict``); ``ended``
+    says why it ended (``time limit``, ``crashed``, ``ended by the pilot``)."""
     terminated = ended not in ("time limit", "ended by the pilot")
-    measures: tuple[Measure, ...] = ()
-    if terminated:
-        success, detail = False, ended
-    else:
-        judge = getattr(task, "judge", None)
-        judged, detail, measures = judge_flight(task.describe(), states, errors, dt, gusty, judge)
-        success = bool(judged)
+    judged = verdict.judge(ended if terminated else None)
+    success = bool(judged is not None and judged.success)
+    detail = "" if judged is None else judged.detail
+    measures: tuple[Measure, ...] = () if judged is None else judged.measures
     graded = grade(success, measures)
     head = ("SUCCESS: " if success else "FAILED: ") + detail
-    lines = [*_wrap(head), f"ended: {ended}; return {total_return:.1f}; {len(errors)} steps"]
+    steps = len(verdict.errors)  # the steps whose error was tracked
+    lines = [*_wrap(head), f"ended: {ended}; return {total_return:.1f}; {steps} steps"]
     lines += _wrap(f"grade: {graded}" + (f" ({said(measures)})" if measures else ""))
     return Debrief(success, detail, tuple(lines), graded)

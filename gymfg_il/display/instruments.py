@@ -1,16 +1,6 @@
-"""The primary flight display's instruments: which flight variable each one shows
-(``display.readings`` draws a reading on its instrument; ``display.guidance`` puts each
-task's targets on the instrument of their variable)."""
+"""Moved to ``gymfg_il.tasks.guidance`` (the instruments a task puts its targets on sit below
+the tasks); this path keeps working for now, with a DeprecationWarning."""
 
-from __future__ import annotations
+from gymfg_il.moved import forward
 
-# each flight variable and the instrument that shows it
-PRIMARY: dict[str, str] = {
-    "airspeed_kts": "airspeed",
-    "altitude_ft": "altitude",
-    "vertical_speed_fps": "vertical_speed",
-    "roll_deg": "bank",
-    "pitch_deg": "pitch",
-    "heading_deg": "heading",
-    "beta_deg": "slip",
-}
+__getattr__ = forward(__name__, "gymfg_il.tasks.guidance")

@@ -20,9 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.display.guidance import guide
-from gymfg_il.display.instruments import PRIMARY
 from gymfg_il.sim.properties import BY_NAME, INDEX
+from gymfg_il.tasks.guidance import PRIMARY
 
 ROLES = ("value", "bug", "needle", "guidance")
 
@@ -86,14 +85,14 @@ def primary(state: np.ndarray) -> list[Reading]:
 
 def task_readings(task: Any, state: np.ndarray, step: int) -> list[Reading]:
     """``task``'s readings at agent ``step`` (the aircraft in catalogue-ordered ``state``):
-    its guidance lines (``display.guidance``) with their values."""
-    lines, values = guide(task)
+    the guidance lines it declares (``tasks.guidance``) with their values."""
+    lines = task.guidance_lines()
     if not lines:
         return []
     observed = dict(zip(task.observation_names, task.observe(state, step).tolist(), strict=True))
     return [
         Reading(line.name, float(value), line.unit, line.instrument, line.role, line.label)
-        for line, value in zip(lines, values(task, observed), strict=True)
+        for line, value in zip(lines, task.guidance_values(observed), strict=True)
     ]
 
 

@@ -175,6 +175,12 @@ class FlightSpec:
         return Weather(self.turbulence, self.wind_kt, self.wind_from_deg)
 
     @property
+    def gusty(self) -> bool:
+        """Whether the flight is in turbulence (``Weather.gusty``): its episodes are judged
+        allowing for gusts (``tasks.verdicts``)."""
+        return self.weather.gusty
+
+    @property
     def aircraft_specs(self) -> list[AircraftSpec]:
         return [a for t in self.teams for a in t.roster]
 

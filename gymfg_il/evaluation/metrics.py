@@ -3,10 +3,11 @@ control effort and smoothness.
 
 Definitions (per episode, then averaged over episodes):
 
-- success: the aircraft did not terminate and, for a maneuver, the task's own judge passed the
-  flown states (``ManeuverTask.judge``); for the target tasks the error held within the
-  tolerance through the last ``hold_s`` seconds (the rule of ``tasks.verdicts``: three times
-  the tolerance for a moving target, on the mean error in turbulence).
+- success: the aircraft did not terminate and the episode's verdict passed
+  (``tasks.verdicts.EpisodeVerdict``: for a maneuver, the task's own judge of the flown
+  states; for the target tasks, the error held within the tolerance through the last 10 s,
+  three times the tolerance for a moving target, on the mean error in turbulence). A trace
+  made by hand, without a verdict, is held to the target rule over ``hold_s``.
 - time_to_target_s: first time ``|error| <= tolerance`` (NaN if never; averaged over the
   episodes that reached it).
 - steady_state_error: mean ``|error|`` over the last ``hold_s`` seconds.

@@ -54,7 +54,7 @@ def evaluate(
     for name, agent in agents.items():
         tick = (lambda _episode, name=name: progress(name)) if progress else None
         episodes = fly_many(flight, agent, seeds, workers, progress=tick)
-        gusty = flight.turbulence != "none"
+        gusty = flight.gusty
         traces[name] = [trace_of(e, gusty=gusty) for e in episodes]
         row = summarize(name, flight.task_label, flight.aircraft, traces[name])
         row.update(

@@ -2,8 +2,9 @@
 
 A ``Trace`` is taken from a rollout ``Episode`` (``trace_of``): the task says which variable
 it brings to a target and which observation entry holds target minus value
-(``Task.tracked()``), and the observation after each step gives both. A maneuver also judges
-its own success from the flown states (``ManeuverTask.judge``); the trace keeps the verdict.
+(``Task.tracked()``), and the observation after each step gives both. The trace keeps the
+episode's verdict (``tasks.verdicts.EpisodeVerdict``: a maneuver's judge on the flown states,
+or the target rule on the error).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.rollout.records import Episode
+from gymfg_il.tasks.verdicts import EpisodeVerdict
 
 
 @dataclass
@@ -38,7 +40,8 @@ class Trace:
     terminated: bool
     reason: str | None
     gusty: bool = False  # flown in turbulence: success is judged on the mean error
-    # a maneuver's own judgement (``ManeuverTask.judge``): success and what decided it
+    # the task's verdict on what was flown, whatever ended it (``tasks.verdicts``; None in a
+    # trace made by hand: ``score_episode`` applies the target rule), and a maneuver's words
     verdict: bool | None = None
     detail: str = ""
     # the catalogue states from the reset on (maneuvers: for ground tracks and profiles)
@@ -91,15 +94,17 @@ def make_trace(
         raise ConfigError(f"task {task.get('task')!r} has no target to evaluate against")
     names = list(task["observation"])
     after = np.asarray(next_observations, dtype=np.float64).reshape(len(rewards), len(names))
-    verdict, detail, plan = None, "", task.get("plan")
-    if plan is not None:
+    value = after[:, names.index(tracked["variable"])]
+    error = after[:, names.index(tracked["error"])]
+    plan, judge = task.get("plan"), None
+    if plan is not None:  # the task the flight names, a task of your own included
         from gymfg_il.tasks.library import task_class
 
         judge = task_class(task["task"]).judge  # type: ignore[attr-defined]
-        judged = judge(plan, states, dt, gusty)
-        verdict, detail = judged.success, judged.detail
-    value = after[:, names.index(tracked["variable"])]
-    error = after[:, names.index(tracked["error"])]
+    judged = EpisodeVerdict.flown(task, states, error, dt, gusty, judge).judge()
+    verdict = None if judged is None else judged.success
+    # a target task's rows have no words (its figures say it)
+    detail = judged.detail if judged is not None and plan is not None else ""
     return Trace(
         seed=seed,
         variable=tracked["variable"],

@@ -138,7 +138,7 @@ class LeRobotFlightEnv(gym.Env):
             terminated,
             reason,
             np.array(steps["state"]),
-            gusty=self.flight.turbulence != "none",
+            gusty=self.flight.gusty,
         )
         return score_episode(trace).success
 

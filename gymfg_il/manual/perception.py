@@ -6,9 +6,9 @@ vector, no integral, no body rate. ``DisplayIntent`` is the intent of the synthe
 the task's expert loops (``controllers.autopilot``, flown with a person's hands on that
 aircraft: ``Hands``, ``hands_of``), fed only with readings the window draws, and with the
 two rates a person reads from the moving attitude indicator (how fast the horizon rolls and
-pitches). Each task's targets are taken from its bugs and guidance (``DISPLAY_SOURCES``); a
-reading the window does not draw cannot be read: building the intent for a task fails if its
-loops need one.
+pitches). Each task's targets are taken from its bugs and guidance, where its expert says
+(``tasks.experts.Expert.on_display``); a reading the window does not draw cannot be read:
+building the intent for a task fails if its loops need one.
 """
 
 from __future__ import annotations
@@ -21,15 +21,15 @@ import numpy as np
 
 from gymfg_il.controllers.autopilot import Autopilot, controller_for
 from gymfg_il.controllers.gains import Gains
-from gymfg_il.display.guidance import reading_names
 from gymfg_il.display.readings import Display
+from gymfg_il.moved import forward_names
+from gymfg_il.tasks.guidance import reading_names
 from gymfg_il.units import DEG_TO_RAD, wrap_180
 
 # the rates the eye reads off the attitude indicator's motion: rate -> the reading it moves
 MOTION = {"p_rad_s": "roll_deg", "q_rad_s": "pitch_deg"}
 ANGLES = {"heading_deg", "heading_deg_target", "gate_bearing_deg", "lead_heading_deg"}
 ANGLES |= {"runway_course_deg", "roll_deg", "lead_roll_deg"}
-_NONE: frozenset[str] = frozenset()
 
 
 @dataclass(frozen=True)
@@ -72,34 +72,6 @@ HANDS: dict[str, Hands] = {
     "f15": Hands(anticipate=0.5),
     "c172p": Hands(slot_ahead_ft=30.0, slot_track=0.5, slot_throttle_floor=0.4),
 }
-# where each task's loops take their targets from on the display (the expert's other settings
-# and gains stay); a target task's bug is named as the expert's source already
-DISPLAY_SOURCES: dict[str, dict[str, Any]] = {
-    "turn": {
-        "vertical_source": "altitude_ft_target",
-        "lateral_source": "turn_remaining_deg",
-        "relative": frozenset({"lateral"}),
-    },
-    "waypoints": {
-        "vertical_source": "gate_altitude_ft",
-        "lateral_source": "gate_bearing_deg",
-        "relative": _NONE,
-    },
-    "formation": {
-        "lateral_source": "lead_heading_deg",
-        "relative": frozenset({"vertical"}),
-    },
-    "approach": {
-        "lateral_source": "runway_course_deg",
-        "speed_source": "approach_kts",
-        "relative": frozenset({"vertical"}),
-    },
-    "level": {
-        "vertical_source": "altitude_ft_target",
-        "lateral_source": "heading_deg_target",
-        "relative": _NONE,
-    },
-}
 
 
 def hands_of(gains: Gains, hands: Hands) -> Gains:
@@ -127,8 +99,8 @@ class DisplayIntent:
 
     def __init__(self, task: Any, model: str, dt: float, throttle: float) -> None:
         expert = controller_for(task, model, dt, throttle)
-        sources = DISPLAY_SOURCES.get(str(getattr(task, "name", "")), {})
-        targets = dataclasses.replace(expert.targets, **sources)
+        declared = task.expert()  # not None: the task has an expert to build
+        targets = dataclasses.replace(expert.targets, **declared.on_display)
         self.hands = HANDS.get(model, Hands())
         kp, kd = targets.station_gains
         station = (kp * self.hands.station, kd * self.hands.station)
@@ -175,3 +147,11 @@ class DisplayIntent:
             seen = seen.copy()
             seen[self.names.index("behind_slot_ft")] += self.hands.slot_ahead_ft
         return self.autopilot.act(seen)
+
+
+# a table whose knowledge each task now declares itself
+__getattr__ = forward_names(
+    __name__,
+    {},
+    gone={"DISPLAY_SOURCES": "each task's expert declares it: Task.expert().on_display"},
+)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
+from typing import Any
 
 from gymfg_il.recording import foxglove
 from gymfg_il.sim.properties import ACTION_NAMES, CATALOGUE
@@ -144,3 +145,21 @@ LOCATION_FIX = foxglove.schema("foxglove.LocationFix")
 
 def encoded(schema: Mapping[str, object]) -> bytes:
     return json.dumps(schema).encode()
+
+
+def register_all(w: Any) -> dict[str, int]:
+    """Register the log's message schemas with ``w`` (an ``mcap.writer.Writer``), ours then
+    Foxglove's 3D ones; their ids by name."""
+    ours = {
+        "gymfg.Step": STEP,
+        "gymfg.EpisodeEvent": EPISODE_EVENT,
+        "gymfg.State": STATE,
+        "foxglove.LocationFix": LOCATION_FIX,
+        "gymfg.OpponentView": OPPONENT_VIEW,
+    }
+    ids = {
+        name: w.register_schema(name, "jsonschema", encoded(body)) for name, body in ours.items()
+    }
+    for name in ("foxglove.FrameTransform", "foxglove.SceneUpdate"):
+        ids[name] = w.register_schema(name, "jsonschema", encoded(foxglove.schema(name)))
+    return ids

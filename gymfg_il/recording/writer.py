@@ -27,7 +27,7 @@ from gymfg_il.recording.schemas import EPISODE_TOPIC, aircraft_topic, view_topic
 from gymfg_il.recording.session import CHANNELS_METADATA, SESSION_COPY, SESSION_METADATA, checked
 from gymfg_il.rollout.records import Episode, OpponentView, Start, Tick
 from gymfg_il.sim.properties import ACTION_NAMES, INDEX, NAMES
-from gymfg_il.tasks.scenery import task_landmarks
+from gymfg_il.tasks.library import task_landmarks
 from gymfg_il.units import DEG_TO_RAD, FT_TO_M
 
 _INITIAL = ("lat_deg", "lon_deg", "altitude_ft")
@@ -46,25 +46,6 @@ def _start_record(s: Start) -> dict[str, Any]:
     if s.task.get("plan") is not None:
         record["plan"] = s.task["plan"]
     return record
-
-
-def _register_schemas(w: Writer) -> dict[str, int]:
-    """Register the log's message schemas with ``w``, ours then Foxglove's 3D ones; their ids
-    by name."""
-    ours = {
-        "gymfg.Step": schemas.STEP,
-        "gymfg.EpisodeEvent": schemas.EPISODE_EVENT,
-        "gymfg.State": schemas.STATE,
-        "foxglove.LocationFix": schemas.LOCATION_FIX,
-        "gymfg.OpponentView": schemas.OPPONENT_VIEW,
-    }
-    ids = {
-        name: w.register_schema(name, "jsonschema", schemas.encoded(body))
-        for name, body in ours.items()
-    }
-    for name in ("foxglove.FrameTransform", "foxglove.SceneUpdate"):
-        ids[name] = w.register_schema(name, "jsonschema", schemas.encoded(fg.schema(name)))
-    return ids
 
 
 class TrajectoryWriter:
@@ -131,7 +112,7 @@ class TrajectoryWriter:
         state, location, pose and scene, and each team's view where teams see others; the
         topic of every channel by its id."""
         w = self._writer
-        ids = _register_schemas(w)
+        ids = schemas.register_all(w)
         topics: dict[int, str] = {}
 
         def channel(topic: str, schema: str) -> int:

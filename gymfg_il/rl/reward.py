@@ -23,7 +23,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from gymfg_il.tasks.verdicts import judge_flight
+from gymfg_il.tasks.verdicts import EpisodeVerdict
 
 
 def per_env(env: gym.Env, success_bonus: float) -> gym.Env:
@@ -41,52 +41,41 @@ def normalize(venv: Any, gamma: float) -> Any:
 
 
 class SuccessBonus(gym.Wrapper):
-    """At the end of each episode, judge it as ``eval`` does (``tasks.verdicts``: a maneuver
-    by its judge, a target task by the held error; an episode that terminated failed), set
-    ``info["is_success"]`` (stable-baselines3 logs it as ``rollout/success_rate``) and add
-    ``share`` x the episode's steps to the last reward of a success (a step's task reward is
-    at most about 1)."""
+    """At the end of each episode, judge it as ``eval`` does (``tasks.verdicts.EpisodeVerdict``:
+    a maneuver by its judge, a target task by the held error; an episode that terminated
+    failed), set ``info["is_success"]`` (stable-baselines3 logs it as
+    ``rollout/success_rate``) and add ``share`` x the episode's steps to the last reward of a
+    success (a step's task reward is at most about 1)."""
 
     def __init__(self, env: gym.Env, share: float) -> None:
         super().__init__(env)
         self.share = share
         self._flight: Any = env.unwrapped
-        self._states: list[np.ndarray] = []
-        self._errors: list[float] = []
-        self._task: dict[str, Any] = {}
-        self._at: int | None = None
+        self._verdict: EpisodeVerdict | None = None
 
     def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
         obs, info = self.env.reset(**kwargs)
-        self._task = self._flight.task.describe()
-        tracked = self._task.get("tracked") or {}
-        names = list(self._task.get("observation", []))
-        self._at = names.index(tracked["error"]) if tracked.get("error") in names else None
-        self._states = [self._state()]
-        self._errors = []
+        flight = self._flight
+        # judged by the library's judge of the task the record names (not a task's own)
+        record = flight.task.describe()
+        self._verdict = EpisodeVerdict(record, flight.dt, flight.flight.gusty)
+        self._verdict.start(self._state())
         return obs, info
 
     def _state(self) -> np.ndarray:
-        state: np.ndarray = self._flight.world.slots[0].state.copy()
+        state: np.ndarray = self._flight.world.slots[0].state
         return state
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         obs, reward, terminated, truncated, info = self.env.step(action)
-        self._states.append(self._state())
-        if self._at is not None:
-            self._errors.append(float(obs[self._at]))
+        verdict = self._verdict
+        assert verdict is not None, "reset() first"
+        verdict.add(self._state(), obs)
         if terminated or truncated:
             # a maneuver the library cannot judge (a task of your own) earns no bonus
-            success = False if terminated else self._judge()
-            if success is not None:
-                info["is_success"] = success
-            if success:
-                reward = float(reward) + self.share * (len(self._states) - 1)
+            found = verdict.judge("terminated" if terminated else None)
+            if found is not None:
+                info["is_success"] = found.success
+            if found is not None and found.success:
+                reward = float(reward) + self.share * verdict.steps
         return obs, float(reward), terminated, truncated, info
-
-    def _judge(self) -> bool | None:
-        flight = self._flight
-        gusty = flight.flight.turbulence != "none"
-        errors = np.asarray(self._errors)
-        success, _, _ = judge_flight(self._task, np.vstack(self._states), errors, flight.dt, gusty)
-        return success

@@ -57,8 +57,13 @@ class Weather:
             raise ConfigError("weather: " + "; ".join(problems))
 
     @property
+    def gusty(self) -> bool:
+        """Whether the air is turbulent (a verdict then allows for gusts: ``tasks.verdicts``)."""
+        return self.turbulence != "none"
+
+    @property
     def calm(self) -> bool:
-        return self.turbulence == "none" and not self.wind_kt
+        return not self.gusty and not self.wind_kt
 
     def draw(self, rng: np.random.Generator) -> Air:
         """This episode's air (the turbulence seed, the wind's direction if it has none)."""

@@ -1,9 +1,14 @@
-"""Tasks: each aircraft's observation, reward, termination and start state.
+"""Tasks: each aircraft's observation, reward, termination and start state, and what the rest
+of the toolkit knows of a task, which the task declares itself: its guidance lines, its
+tracked target and its expert's structure.
 
 Submodules: ``base`` (Task), ``targets`` (static/dynamic target machinery), ``library`` (the
-named tasks), ``paths`` (tasks of your own named by import path, and the trust a record needs
-to name one), ``rewards`` (RewardContext and shaping), ``geometry``, ``orientation`` and
-``state`` (the state-variable catalogue and StateView).
+named tasks), ``maneuvers``, ``courses``, ``approach`` and ``formation`` (the maneuvers),
+``paths`` (tasks of your own named by import path, and the trust a record needs to name
+one), ``rewards`` (RewardContext and shaping), ``guidance`` (what a task shows a pilot),
+``experts`` (the structure of a task's expert), ``verdicts`` (``EpisodeVerdict``: one
+accumulator judges every episode) and ``grades``, ``scenery`` (what a camera draws),
+``geometry``, ``orientation`` and ``state`` (the state-variable catalogue and StateView).
 """
 
 from gymfg_il.tasks.base import FLIGHT_VARS, Task

@@ -3,12 +3,19 @@
 A task instance belongs to one aircraft in one environment (the environment builds it from the
 team roster). Subclasses set ``observation_vars`` and override ``reward`` (or any hook); a new
 reward without a subclass is one lambda: ``DummyTask(reward=lambda ctx: ...)``.
+
+A task also owns what the rest of the toolkit knows of it: what the window shows a pilot of
+it (``guidance_lines``, ``guidance_values``: ``tasks.guidance``), which target it brings
+within which tolerance (``tracked``: the verdict's, ``tasks.verdicts``), and the structure of
+its expert (``expert``: ``tasks.experts``), which the controllers and the synthetic pilot
+build their loops from.
 """
 
 from __future__ import annotations
 
 import inspect
 import math
+from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import numpy as np
@@ -17,6 +24,8 @@ from gymfg_il.aircraft import Aircraft, FlightProfile
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import BY_NAME, INDEX, indices
+from gymfg_il.tasks.experts import Expert
+from gymfg_il.tasks.guidance import Line, target_bugs
 from gymfg_il.tasks.rewards import RewardContext, RewardFn
 
 # The flight state every built-in task observes, before its own extras.
@@ -77,6 +86,8 @@ class Task:
     extra_names: ClassVar[tuple[str, ...]] = ()
     # how long an episode of this task lasts unless the flight says otherwise (seconds)
     episode_time_s: ClassVar[float] = 90.0
+    # what the window shows beyond the primary instruments (``guidance_lines``)
+    guidance: ClassVar[tuple[Line, ...] | None] = None
 
     @classmethod
     def episode_time_for(cls, profile: FlightProfile) -> float:
@@ -205,6 +216,25 @@ class Task:
         (``variable``), the observation entry holding target minus value (``error``), the
         ``tolerance`` within which it counts as reached and whether the target moves
         (``dynamic``); None for tasks without one."""
+        return None
+
+    # -- what a pilot is shown (``tasks.guidance``) --------------------------------------
+    def guidance_lines(self) -> tuple[Line, ...]:
+        """The readings the window shows for this task beyond the primary instruments: the
+        class's ``guidance``; without one, a bug for every target of a primary instrument
+        the task observes."""
+        if self.guidance is not None:
+            return self.guidance
+        return target_bugs(self.observation_names)
+
+    def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
+        """The values of ``guidance_lines()`` from this step's observation (by name); by
+        default the observed entries of the same names."""
+        return [observed[line.name] for line in self.guidance_lines()]
+
+    def expert(self) -> Expert | None:
+        """The structure of the expert that flies this task (``tasks.experts``), which
+        ``controllers.autopilot.controller_for`` builds; None: the task has none."""
         return None
 
     def describe(self) -> dict[str, Any]:

@@ -11,7 +11,8 @@ log, a dataset's episode or a judge has both aircraft.
 from __future__ import annotations
 
 import math
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -19,8 +20,10 @@ from gymfg_il.aircraft import REFERENCE_PROFILE
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import INDEX, indices
+from gymfg_il.tasks.experts import Targets
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.grades import Measure
+from gymfg_il.tasks.guidance import Line
 from gymfg_il.tasks.maneuvers import ManeuverTask, Verdict
 from gymfg_il.tasks.rewards import closeness
 from gymfg_il.tasks.scenery import Landmark
@@ -115,6 +118,42 @@ class FormationTask(ManeuverTask):
     join_s = 30.0
     tolerance_ft = 100.0
     min_separation_ft = 50.0
+    # the lead's heading and bank as bugs; the slot's offset (behind/ahead, right/left,
+    # below/above) and the closure rate, in words and on a diagram
+    guidance = (
+        Line("lead_heading_deg", "deg", "heading", "bug", "the lead's heading"),
+        Line("lead_roll_deg", "deg", "bank", "bug", "the lead's bank"),
+        Line("behind_slot_ft", "ft", "slot", "guidance", "off the slot, along"),
+        Line("right_of_slot_ft", "ft", "slot", "guidance", "off the slot, across"),
+        Line("below_slot_ft", "ft", "slot", "guidance", "off the slot, height"),
+        Line("behind_slot_rate_fps", "ft/s", "slot", "guidance", "closure"),
+    )
+
+    expert_targets = Targets(
+        vertical_source="below_slot_ft",
+        lateral="track",
+        lateral_source="lead_heading_error_deg",
+        track_source="right_of_slot_ft",
+        track_gain=0.2,
+        station_source="behind_slot_ft",
+        station_rate_source="behind_slot_rate_fps",
+        relative=frozenset({"vertical", "lateral"}),
+    )
+    expert_on_display: ClassVar[Mapping[str, Any]] = {
+        "lateral_source": "lead_heading_deg",
+        "relative": frozenset({"vertical"}),
+    }
+
+    def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
+        o = observed
+        return [
+            wrap_360(o["heading_deg"] + o["lead_heading_error_deg"]),
+            o["lead_roll_deg"],
+            o["behind_slot_ft"],
+            o["right_of_slot_ft"],
+            o["below_slot_ft"],
+            o["behind_slot_rate_fps"],
+        ]
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
         profile = self._profile()

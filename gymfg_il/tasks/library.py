@@ -21,14 +21,18 @@ it ``truncated``. The action is ``[aileron, elevator, rudder, throttle]``.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.experts import Expert, Targets
+from gymfg_il.tasks.guidance import bug
 from gymfg_il.tasks.paths import import_task
 from gymfg_il.tasks.rewards import RewardContext, action_change
+from gymfg_il.tasks.scenery import Landmark, landmarks_of
 from gymfg_il.tasks.targets import (
     AIRSPEED,
     ALTITUDE,
@@ -52,6 +56,10 @@ class DummyTask(Task):
     """
 
     name = "dummy"
+
+    def expert(self) -> Expert:
+        """The autopilot holding what it had: altitude, wings level, airspeed."""
+        return Expert()
 
 
 _TARGET_DOC = """
@@ -187,6 +195,22 @@ class LevelFlightTask(Task):
     extra_names = ("altitude_ft_error", "heading_deg_error")
     altitude_tolerance = 50.0
     heading_tolerance = 3.0
+    # the start altitude and heading as bugs
+    guidance = (bug("altitude_ft_target", "altitude to hold"), bug("heading_deg_target", "heading"))
+
+    def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
+        return [self.start_altitude, self.start_heading]
+
+    def expert(self) -> Expert:
+        """Hold the start altitude and heading (read off their bugs on the window)."""
+        return Expert(
+            Targets(lateral="heading", lateral_source=None),
+            on_display={
+                "vertical_source": "altitude_ft_target",
+                "lateral_source": "heading_deg_target",
+                "relative": frozenset(),
+            },
+        )
 
     def _extra_bounds(self) -> tuple[list[float], list[float]]:
         return [-1e5, -180.0], [1e5, 180.0]
@@ -243,7 +267,8 @@ TASK_FAMILIES: dict[str, tuple[type[Task], type[Task]]] = {
 
 def _add_maneuvers() -> tuple[str, ...]:
     """Register the maneuvers (they import this module's tasks); their names, in order."""
-    from gymfg_il.tasks.courses import ApproachTask, WaypointsTask
+    from gymfg_il.tasks.approach import ApproachTask
+    from gymfg_il.tasks.courses import WaypointsTask
     from gymfg_il.tasks.formation import FormationTask
     from gymfg_il.tasks.maneuvers import ClimbTurnTask, TurnTask
 
@@ -291,3 +316,18 @@ def task_reference(cls: type[Task]) -> tuple[str, bool]:
         if cls is moving:
             return family, True
     return f"{cls.__module__}:{cls.__qualname__}", False
+
+
+def task_landmarks(task: str, plan: dict[str, Any] | None, step: int) -> list[Landmark]:
+    """``tasks.scenery.landmarks_of`` for a task named as the library names it
+    (``waypoints``, ...); none for a task the library does not know (a user's own maneuver:
+    a recording or a video must not stop on its scenery)."""
+    from gymfg_il.errors import ConfigError
+
+    if not plan:
+        return []
+    try:
+        cls = task_class(task)
+    except ConfigError:
+        return []
+    return landmarks_of(cls, plan, step)

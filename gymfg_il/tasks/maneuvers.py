@@ -23,7 +23,7 @@ c172p, 1.7 for the f15 at 45 deg of bank, 2.1 for the A320 at 30), and one that 
 maneuver faster stretches the distances flown in a given time by ``speed_scale``. Both are 1
 on the c172p, whose plans are those drawn before the scaling existed, bit for bit. Tolerances
 stay as a pilot states them (feet, degrees, knots) on every aircraft. The experts fly each
-maneuver banked at most ``bank_deg`` (``controllers.autopilot.scaled_for``).
+maneuver banked at most ``bank_deg`` (``ManeuverTask.expert``).
 
 This module holds the shared machinery and the turn tasks; ``tasks.courses`` holds the tasks
 flown over the ground (waypoints, approach) and ``tasks.formation`` the formation slot.
@@ -32,7 +32,8 @@ flown over the ground (waypoints, approach) and ``tasks.formation`` the formatio
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -40,7 +41,9 @@ import numpy as np
 from gymfg_il.aircraft import REFERENCE_PROFILE, FlightProfile
 from gymfg_il.sim.properties import INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.experts import Expert, Targets
 from gymfg_il.tasks.grades import Measure, grade
+from gymfg_il.tasks.guidance import Line, bug
 from gymfg_il.tasks.rewards import RewardContext, action_change, closeness
 from gymfg_il.units import FT_PER_DEG, wrap_180, wrap_360
 
@@ -103,6 +106,11 @@ class ManeuverTask(Task):
     episode_time_s: ClassVar[float] = 90.0
     # (variable, observation entry of target minus value, tolerance): what plots draw
     tracked_entry: ClassVar[tuple[str, str, float]] = ("heading_deg", "heading_deg_error", 3.0)
+    # the expert (``expert``): the autopilot's loops fed from the entries the maneuver
+    # observes, and the readings of the window they take their targets from instead when a
+    # pilot sees only the window (``tasks.experts.Expert.on_display``)
+    expert_targets: ClassVar[Targets | None] = None
+    expert_on_display: ClassVar[Mapping[str, Any]] = {}
 
     @classmethod
     def episode_time_for(cls, profile: FlightProfile) -> float:
@@ -183,6 +191,19 @@ class ManeuverTask(Task):
         smooth = action_change(ctx.prev_action, ctx.action)
         return self.shaped(extras, state) - SMOOTHNESS_WEIGHT * smooth
 
+    def expert(self) -> Expert | None:
+        """``expert_targets``, flown once bound as its aircraft's pilot would: banked at most
+        its profile's ``bank_deg`` (the maneuver gains), the track gain divided by the task's
+        ``speed_scale`` (a line closed in the same seconds whatever the speed); unchanged on
+        the c172p."""
+        targets, on_display = self.expert_targets, self.expert_on_display
+        if targets is None:
+            return None
+        if self.aircraft is None:
+            return Expert(targets, on_display=on_display)
+        scaled = replace(targets, track_gain=targets.track_gain / self.speed_scale())
+        return Expert(scaled, self.aircraft.profile.bank_deg, on_display)
+
     def tracked(self) -> dict[str, Any]:
         variable, error, tolerance = self.tracked_entry
         return {"variable": variable, "error": error, "tolerance": tolerance, "dynamic": True}
@@ -216,6 +237,29 @@ class TurnTask(ManeuverTask):
     tracked_entry = ("heading_deg", "turn_remaining_deg", 5.0)
     altitude_tolerance = 100.0
     heading_tolerance = 5.0
+    # the altitude and the new heading as bugs, the turn still to fly with its direction
+    guidance = (
+        bug("altitude_ft_target", "altitude to hold"),
+        bug("heading_deg_target", "new heading"),
+        Line("turn_remaining_deg", "deg", "panel", "guidance", "turn still to fly"),
+    )
+
+    expert_targets = Targets(
+        vertical_source="altitude_ft_error",
+        lateral="heading",
+        lateral_source="turn_remaining_deg",
+        relative=frozenset({"vertical", "lateral"}),
+    )
+    expert_on_display: ClassVar[Mapping[str, Any]] = {
+        "vertical_source": "altitude_ft_target",
+        "lateral_source": "turn_remaining_deg",
+        "relative": frozenset({"lateral"}),
+    }
+
+    def guidance_values(self, observed: Mapping[str, float]) -> list[float]:
+        plan = self.plan
+        heading = wrap_360(plan["start_heading_deg"] + plan["turn_deg"])
+        return [plan["altitude_ft"], heading, observed["turn_remaining_deg"]]
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
         return {
@@ -296,6 +340,12 @@ class ClimbTurnTask(ManeuverTask):
     tracked_entry = ("altitude_ft", "altitude_ft_error", 50.0)
     altitude_tolerance = 50.0
     heading_tolerance = 3.0
+    # the new altitude and heading as bugs (the entries of the same names, which the expert
+    # flies to: the window draws its sources already)
+    guidance = (bug("altitude_ft_target", "new altitude"), bug("heading_deg_target", "new heading"))
+    expert_targets = Targets(
+        vertical_source="altitude_ft_target", lateral="heading", lateral_source="heading_deg_target"
+    )
 
     def draw_plan(self, state: np.ndarray, rng: np.random.Generator) -> dict[str, Any]:
         return {

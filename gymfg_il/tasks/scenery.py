@@ -3,7 +3,8 @@
 A ``Landmark`` is a position (geodetic latitude and longitude, altitude in ft), an
 orientation and a size; ``viz.camera`` draws it. Tasks say what they place through
 ``landmarks(plan, step)`` (a classmethod, so a logged plan is enough to redraw a flight);
-tasks without anything to show place nothing.
+tasks without anything to show place nothing. ``tasks.library.task_landmarks`` finds them
+for a task named in a record.
 """
 
 from __future__ import annotations
@@ -13,10 +14,13 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.errors import ConfigError
+from gymfg_il.moved import forward_names
 from gymfg_il.sim.properties import INDEX
 
 KINDS = ("runway", "gate", "aircraft")
+# names that moved out of this module, kept working for now (``task_landmarks`` resolves a
+# task's name, the library's job)
+__getattr__ = forward_names(__name__, {"task_landmarks": "gymfg_il.tasks.library"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,18 +72,3 @@ def landmarks_of(task: Any, plan: dict[str, Any] | None, step: int) -> list[Land
     ``plan`` (``Task.describe()["plan"]``); nothing without a plan."""
     found = getattr(task, "landmarks", None)
     return list(found(plan, step)) if plan and found is not None else []
-
-
-def task_landmarks(task: str, plan: dict[str, Any] | None, step: int) -> list[Landmark]:
-    """``landmarks_of`` for a task named as the library names it (``waypoints``, ...); none
-    for a task the library does not know (a user's own maneuver: a recording or a video
-    must not stop on its scenery)."""
-    if not plan:
-        return []
-    from gymfg_il.tasks.library import task_class
-
-    try:
-        cls = task_class(task)
-    except ConfigError:
-        return []
-    return landmarks_of(cls, plan, step)

@@ -20,6 +20,8 @@ import numpy as np
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.properties import BY_NAME, INDEX
 from gymfg_il.tasks.base import FLIGHT_VARS, Task
+from gymfg_il.tasks.experts import Expert, Targets
+from gymfg_il.tasks.guidance import PRIMARY, Line, bug
 from gymfg_il.tasks.rewards import RewardContext, action_change
 from gymfg_il.units import wrap_180, wrap_360
 
@@ -38,6 +40,9 @@ class TargetFamily:
         rate: how fast a dynamic target moves (variable units per second).
         angular: errors wrap around 360 degrees.
         extra_vars: catalogue variables observed besides the flight state.
+        loop: the autopilot loop that flies it (``tasks.experts.Targets``): its axis and,
+            where the axis has modes, the mode (``("vertical", "altitude")``: ``vertical=
+            "altitude"`` with the target as ``vertical_source``); None: no expert.
     """
 
     key: str
@@ -49,17 +54,44 @@ class TargetFamily:
     rate: float
     angular: bool = False
     extra_vars: tuple[str, ...] = ()
+    loop: tuple[str, str | None] | None = None
 
 
-ALTITUDE = TargetFamily("altitude", "altitude_ft", True, (-1000.0, 1000.0), 200.0, 50.0, 10.0)
-ROLL = TargetFamily("roll", "roll_deg", False, (-30.0, 30.0), 5.0, 2.0, 5.0)
-PITCH = TargetFamily("pitch", "pitch_deg", False, (-4.0, 8.0), 2.0, 1.0, 1.0)
-HEADING = TargetFamily(
-    "heading", "heading_deg", True, (-90.0, 90.0), 10.0, 3.0, 1.0, True, ("heading_deg",)
+ALTITUDE = TargetFamily(
+    "altitude",
+    "altitude_ft",
+    True,
+    (-1000.0, 1000.0),
+    200.0,
+    50.0,
+    10.0,
+    loop=("vertical", "altitude"),
 )
-AIRSPEED = TargetFamily("airspeed", "airspeed_kts", True, (-20.0, 20.0), 5.0, 3.0, 1.0)
+ROLL = TargetFamily(
+    "roll", "roll_deg", False, (-30.0, 30.0), 5.0, 2.0, 5.0, loop=("lateral", "roll")
+)
+PITCH = TargetFamily(
+    "pitch", "pitch_deg", False, (-4.0, 8.0), 2.0, 1.0, 1.0, loop=("vertical", "pitch")
+)
+HEADING = TargetFamily(
+    "heading",
+    "heading_deg",
+    True,
+    (-90.0, 90.0),
+    10.0,
+    3.0,
+    1.0,
+    True,
+    ("heading_deg",),
+    loop=("lateral", "heading"),
+)
+AIRSPEED = TargetFamily(
+    "airspeed", "airspeed_kts", True, (-20.0, 20.0), 5.0, 3.0, 1.0, loop=("speed", None)
+)
 # the rudder's task: hold a sideslip angle (a slip), wings level
-SIDESLIP = TargetFamily("sideslip", "beta_deg", False, (-4.0, 4.0), 1.0, 0.5, 1.0)
+SIDESLIP = TargetFamily(
+    "sideslip", "beta_deg", False, (-4.0, 4.0), 1.0, 0.5, 1.0, loop=("sideslip", None)
+)
 FAMILIES: dict[str, TargetFamily] = {
     f.key: f for f in (ALTITUDE, ROLL, PITCH, HEADING, AIRSPEED, SIDESLIP)
 }
@@ -209,6 +241,23 @@ class TargetTask(Task):
             err = wrap_180(err)
         smooth = action_change(ctx.prev_action, ctx.action)
         return math.exp(-abs(err) / self.reward_scale) - SMOOTHNESS_WEIGHT * smooth
+
+    def guidance_lines(self) -> tuple[Line, ...]:
+        """The target as a bug on its variable's instrument."""
+        instrument = PRIMARY[self.family.variable]
+        label = "target " + {"slip": "sideslip"}.get(instrument, instrument)
+        return (bug(f"{self.family.variable}_target", label),)
+
+    def expert(self) -> Expert | None:
+        """The family's loop (``TargetFamily.loop``) to the ``*_target`` entry; the other
+        axes hold their start values."""
+        if self.family.loop is None:
+            return None
+        axis, mode = self.family.loop
+        loop: dict[str, Any] = {f"{axis}_source": f"{self.family.variable}_target"}
+        if mode is not None:
+            loop[axis] = mode
+        return Expert(Targets(**loop))
 
     def tracked(self) -> dict[str, Any]:
         v = self.family.variable

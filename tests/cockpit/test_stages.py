@@ -17,6 +17,7 @@ from gymfg_il.cockpit.inputs.synthetic_pilot import SyntheticInput
 from gymfg_il.cockpit.phases import Phases, SessionStats
 from gymfg_il.display.readings import Display
 from gymfg_il.manual.controller import ManualController
+from gymfg_il.tasks.verdicts import TrackedError
 
 
 class FakeLog:
@@ -100,7 +101,8 @@ def test_the_synthetic_pilot_returns_its_keys_and_posts_none(monkeypatch):
 @pytest.mark.parametrize("tolerance", [50.0, 10.0])
 def test_the_dagger_gate_takes_over_past_three_tolerances_and_hands_back_once_settled(tolerance):
     pilot = SimpleNamespace(dt=0.1)
-    gate = SyntheticInput(None, pilot, assisted=True, tracked=(1, tolerance))
+    tracked = TrackedError("altitude_ft", "altitude_ft_error", 1, tolerance, False)
+    gate = SyntheticInput(None, pilot, assisted=True, tracked=tracked)
     assert gate._gated(seen(human_flies=False, error=3 * tolerance)) == []
     assert keys(gate._gated(seen(human_flies=False, error=-3.01 * tolerance))) == [
         ("t", True),

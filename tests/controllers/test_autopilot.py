@@ -107,9 +107,26 @@ def test_the_rudder_task_is_found_by_the_papers_name_and_its_dynamic_one_is_trac
     assert errors[100:].max() < 1.0
 
 
+def test_each_task_declares_its_expert_and_the_controller_is_built_from_it():
+    """#53: no table of experts in controllers/; a task of your own declares one too."""
+    from gymfg_il.tasks import DummyTask, Task, task_class
+    from gymfg_il.tasks.experts import Expert, Targets
+
+    class Climb(DummyTask):
+        def expert(self):
+            return Expert(Targets(vertical="climb", vertical_source=5.0))
+
+    assert controller_for(Climb(), "c172p", 0.1).targets.vertical_source == 5.0
+    roll = task_class("roll")().expert()
+    assert roll == Expert(Targets(lateral="roll", lateral_source="roll_deg_target"))
+    assert task_class("airspeed")().expert().targets == Targets(speed_source="airspeed_kts_target")
+    with pytest.raises(ConfigError, match=r"no controller for Task: declare its expert"):
+        controller_for(Task(), "c172p", 0.1)
+
+
 def test_maneuvers_bank_as_the_profile_says_and_close_lines_in_the_same_seconds():
-    from gymfg_il.controllers.autopilot import MANEUVER_TARGETS
     from gymfg_il.controllers.gains import GAINS, MANEUVER_GAINS
+    from gymfg_il.tasks.approach import ApproachTask
 
     def pilot(task, model):
         env = AircraftEnv(task, model)
@@ -118,7 +135,7 @@ def test_maneuvers_bank_as_the_profile_says_and_close_lines_in_the_same_seconds(
         return built
 
     c172 = pilot("approach", "c172p")  # the c172p flies its maneuvers as before the scaling
-    assert c172.targets == MANEUVER_TARGETS["approach"] and c172.gains == GAINS["c172p"]
+    assert c172.targets == ApproachTask.expert_targets and c172.gains == GAINS["c172p"]
     jet = pilot("approach", "f15")
     assert jet.gains.max_roll_deg == 45.0 and jet.gains.roll == MANEUVER_GAINS["f15"].roll
     assert jet.targets.track_gain == pytest.approx(0.03 / 3.0)  # approaching 3x as fast

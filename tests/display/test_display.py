@@ -8,11 +8,11 @@ import pytest
 
 from gymfg_il.cockpit.windows.gui import ControlsGUI, GuiFrame, spoken
 from gymfg_il.display.briefing import briefing, debrief
-from gymfg_il.display.guidance import reading_names
 from gymfg_il.display.readings import PRIMARY, display_of
 from gymfg_il.manual.perception import MOTION, DisplayIntent
 from gymfg_il.rollout.agents import AgentSpec
-from gymfg_il.tasks.library import TASK_FAMILIES
+from gymfg_il.tasks.guidance import Line, reading_names
+from gymfg_il.tasks.library import TASK_FAMILIES, DummyTask
 
 MANEUVERS = ("turn", "climb-turn", "waypoints", "formation", "approach")
 TARGETS = ("altitude", "roll", "pitch", "heading", "airspeed", "sideslip")
@@ -113,6 +113,25 @@ def test_the_briefing_is_the_tasks_docstring_and_the_debrief_its_verdict(make_en
     assert held.success and held.lines[0].startswith("SUCCESS")
     missed = debrief(env.task, states, np.full(400, 80.0), env.dt, "time limit", 400.0)
     assert not missed.success
+
+
+def test_a_task_of_your_own_declares_what_the_window_shows(make_env):
+    """#53: a task owns its guidance; the display reads the declaration, no table."""
+
+    class Glide(DummyTask):
+        name = "glide"
+        guidance = (Line("sink_fpm", "ft/min", "panel", "guidance", "sink rate"),)
+
+        def guidance_values(self, observed):
+            return [-60.0 * observed["vertical_speed_fps"]]
+
+    env, _ = started(make_env, "dummy")
+    state = env.world.slots[0].state
+    task = Glide()
+    task.bind(env.aircraft, env.dt, 900)
+    display = display_of(task, state, 0)
+    assert display.names == reading_names(task) == (*PRIMARY, "sink_fpm")
+    assert display["sink_fpm"] == pytest.approx(-60.0 * display["vertical_speed_fps"], rel=1e-6)
 
 
 def test_every_library_task_is_checked_here():

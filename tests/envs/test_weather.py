@@ -61,6 +61,13 @@ def test_the_weather_is_part_of_the_flight_spec():
             FlightSpec.solo(**bad)
 
 
+def test_a_flight_says_whether_it_is_gusty():
+    """#53: one rule (``Weather.gusty``) for whether a verdict allows for gusts."""
+    assert FlightSpec.solo(task="roll", turbulence="light").gusty
+    assert not FlightSpec.solo(task="roll", wind_kt=10.0).gusty  # a steady wind is no gust
+    assert not FlightSpec.solo(task="roll").weather.gusty and Weather().calm
+
+
 def test_controllers_hold_their_targets_in_moderate_turbulence():
     from gymfg_il.evaluation.config import EvalConfig
     from gymfg_il.evaluation.runner import run_eval

@@ -233,7 +233,7 @@ def test_shipped_layout_shows_what_an_altitude_log_holds(altitude_log):
 def test_scene_draws_what_a_maneuver_places(task, tmp_path):
     """Gates, the runway and a formation's lead are in the 3D view where the task's own
     landmarks (what the camera draws) put them; the lead moves with its track."""
-    from gymfg_il.tasks.scenery import task_landmarks
+    from gymfg_il.tasks.library import task_landmarks
 
     cfg = CollectConfig(task=task, episodes=1, episode_time_s=3, out=tmp_path)
     path = record_autopilot(cfg).log

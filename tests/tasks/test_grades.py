@@ -86,7 +86,7 @@ def test_the_briefing_says_how_each_task_is_graded():
 
 
 def test_the_approach_grades_the_bank_on_final_but_does_not_fail_it():
-    from gymfg_il.tasks.courses import ApproachTask
+    from gymfg_il.tasks.approach import ApproachTask
 
     flight = FlightSpec.solo("c172p", "approach")
     (ep,) = fly_many(flight, AgentSpec.controller(), [4402])

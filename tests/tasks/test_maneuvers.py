@@ -15,7 +15,8 @@ from gymfg_il.evaluation.trace import trace_of
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.rollout.seeded import fly_many
 from gymfg_il.sim.properties import INDEX, NAMES
-from gymfg_il.tasks.courses import ApproachTask, WaypointsTask
+from gymfg_il.tasks.approach import ApproachTask
+from gymfg_il.tasks.courses import WaypointsTask
 from gymfg_il.tasks.geometry import offset_position
 from gymfg_il.tasks.maneuvers import ClimbTurnTask, TurnTask
 from gymfg_il.units import FT_PER_NM, wrap_180

@@ -16,6 +16,7 @@ from typing import Any
 from gymfg_il.cockpit.inputs.devices import DeviceInput
 from gymfg_il.cockpit.inputs.source import Polled, Seen
 from gymfg_il.manual.synthetic import SyntheticPilot, key_codes
+from gymfg_il.tasks.verdicts import TrackedError
 
 
 def tap(key: str) -> list[Any]:
@@ -36,8 +37,9 @@ class SyntheticInput:
         devices: the session's devices (pygame's queue still reads a person's Q).
         pilot: the model of a person (``manual.synthetic``).
         assisted: an assistant flies until the pilot takes over.
-        tracked: the task's tracked error (its index in the observation) and tolerance, for
-            the gate (None: a task without a target, never gated).
+        tracked: the task's tracked error, as every verdict reads it
+            (``tasks.verdicts.TrackedError``), for the gate (None: a task without a target,
+            never gated).
         gate: with an assistant, take over when |error| exceeds this many tolerances.
         settle_s: hand back after the error has stayed within the tolerance this long.
     """
@@ -48,7 +50,7 @@ class SyntheticInput:
         pilot: SyntheticPilot,
         *,
         assisted: bool,
-        tracked: tuple[int, float] | None,
+        tracked: TrackedError | None,
         gate: float = 3.0,
         settle_s: float = 3.0,
     ) -> None:
@@ -84,8 +86,8 @@ class SyntheticInput:
         """T when the error grows too large; T again once it has settled."""
         if self.tracked is None or seen.observation is None:
             return []
-        at, tolerance = self.tracked
-        error = abs(float(seen.observation[at]))
+        tolerance = self.tracked.tolerance
+        error = abs(self.tracked(seen.observation))
         if not seen.human_flies:
             if error > self.gate * tolerance:
                 self._settled = 0.0
