@@ -171,8 +171,15 @@ class Autopilot:
         if self.start is None:
             self.start = list(obs)
             self.speed_pid.bias = self.throttle_trim
+        nose_up = self._vertical(obs)
+        aileron = self._lateral(obs)
+        throttle = self._speed(obs)
+        return np.array([aileron, -nose_up, self._rudder(obs), throttle])
+
+    def _vertical(self, obs: list[float]) -> float:
+        """Altitude -> climb rate -> pitch -> elevator, as the nose-up command (positive
+        elevator = nose down)."""
         i, g, t, dt = self.index, self.gains, self.targets, self.dt
-        # vertical: altitude -> climb rate -> pitch -> elevator (positive elevator = nose down)
         if t.vertical == "pitch":
             pitch_target = self._value(obs, t.vertical_source, "pitch_deg")
         else:
@@ -192,10 +199,13 @@ class Autopilot:
             pitch_target = self.climb_pid(climb_target, obs[i["vertical_speed_fps"]], dt)
         pitch_target = max(-g.max_pitch_deg, min(g.max_pitch_deg, pitch_target))
         self._load_integral("pitch", self.pitch_pid, obs, pitch_target - obs[i["pitch_deg"]])
-        nose_up = self.pitch_pid(
-            pitch_target, obs[i["pitch_deg"]], dt, obs[i["q_rad_s"]] * RAD_TO_DEG
+        return float(
+            self.pitch_pid(pitch_target, obs[i["pitch_deg"]], dt, obs[i["q_rad_s"]] * RAD_TO_DEG)
         )
-        # lateral: heading -> roll -> aileron
+
+    def _lateral(self, obs: list[float]) -> float:
+        """Heading (or a track) -> roll -> aileron."""
+        i, g, t, dt = self.index, self.gains, self.targets, self.dt
         if t.lateral in ("heading", "track"):
             heading_target = self._value(obs, t.lateral_source, "heading_deg", "lateral")
             if t.lateral == "track":  # the line's course, turned towards the line
@@ -217,8 +227,13 @@ class Autopilot:
             else roll_target
         )
         self._load_integral("roll", self.roll_pid, obs, roll_target - obs[i["roll_deg"]])
-        aileron = self.roll_pid(roll_target, obs[i["roll_deg"]], dt, obs[i["p_rad_s"]] * RAD_TO_DEG)
-        # speed: airspeed -> throttle; rudder: sideslip -> 0
+        return float(
+            self.roll_pid(roll_target, obs[i["roll_deg"]], dt, obs[i["p_rad_s"]] * RAD_TO_DEG)
+        )
+
+    def _speed(self, obs: list[float]) -> float:
+        """Airspeed (or station on a slot) -> throttle."""
+        i, t = self.index, self.targets
         if t.station_source is not None:
             kp, kd = t.station_gains
             ask = kp * obs[i[t.station_source]] + kd * obs[i[str(t.station_rate_source)]]
@@ -226,13 +241,15 @@ class Autopilot:
         else:
             speed_target = self._value(obs, t.speed_source, "airspeed_kts", "speed")
         self._load_integral("speed", self.speed_pid, obs, speed_target - obs[i["airspeed_kts"]])
-        throttle = self.speed_pid(speed_target, obs[i["airspeed_kts"]], dt)
-        if t.sideslip_source is None:  # coordinated flight: sideslip to zero
-            rudder = max(-1.0, min(1.0, self.rudder_trim - g.sideslip * obs[i["beta_deg"]]))
-        else:  # a slip: rudder to the sideslip target (more rudder, more sideslip)
-            slip_target = self._value(obs, t.sideslip_source, "beta_deg")
-            rudder = self.slip_pid(slip_target, obs[i["beta_deg"]], dt)
-        return np.array([aileron, -nose_up, rudder, throttle])
+        return float(self.speed_pid(speed_target, obs[i["airspeed_kts"]], self.dt))
+
+    def _rudder(self, obs: list[float]) -> float:
+        """Sideslip to zero (coordinated flight), or to the task's slip target."""
+        i, t = self.index, self.targets
+        if t.sideslip_source is None:
+            return max(-1.0, min(1.0, self.rudder_trim - self.gains.sideslip * obs[i["beta_deg"]]))
+        slip_target = self._value(obs, t.sideslip_source, "beta_deg")  # more rudder, more slip
+        return float(self.slip_pid(slip_target, obs[i["beta_deg"]], self.dt))
 
 
 def controller_for(task: object, model: str, dt: float, throttle_trim: float = 0.7) -> Autopilot:
