@@ -66,6 +66,14 @@ class PolicyConfig:
         """The frames each training sample holds (default: frame ``t`` alone)."""
         return Window()
 
+    @property
+    def stateful(self) -> bool:
+        """Whether the policy carries state from step to step of an episode (a recurrent
+        state, integrals of errors): every consumer resets it at an episode's start
+        (``PolicyAgent.reset``) and calls the policy at every step, also where its action is
+        not flown (a person's takeover), so the state follows the flight. Default: none."""
+        return False
+
     def for_data(self, data: DatasetInfo) -> Self:
         """This configuration completed from the dataset it trains on (default: as it is)."""
         return self

@@ -38,6 +38,10 @@ class GRUConfig(PolicyConfig):
         return problems
 
     @property
+    def stateful(self) -> bool:
+        return True
+
+    @property
     def window(self) -> Window:
         steps = tuple(range(self.sequence_length))
         return Window(observation=steps, action=steps, pad=False)
