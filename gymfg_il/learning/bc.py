@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.config import TrainConfig, epochs_for, resolve_device
+from gymfg_il.policies.memory import NAMES as MEMORY_NAMES
 
 if TYPE_CHECKING:
     from gymfg_il.envs.flight import FlightSpec
@@ -194,11 +195,13 @@ def demonstrations(
     less what a policy flew unaided."""
     from gymfg_il.learning.data import check_tasks, load_frames
     from gymfg_il.learning.data_checks import check_trainable
+    from gymfg_il.learning.memory import remembered
     from gymfg_il.learning.selection import once_each, selected
 
     if frames is None or (camera is not None and frames.camera != camera):
         frames = load_frames(cfg.dataset, camera)
     check_tasks(frames.episodes, cfg.mixed_tasks)
+    frames = remembered(frames, cfg.policy)  # each episode whole, before frames are left out
     frames = selected(once_each(frames, cfg.dataset), cfg.select, cfg.dataset)
     if cfg.shift != "0":
         from gymfg_il.learning.reaction import shifted
@@ -270,7 +273,9 @@ def run_meta(
         "task": flight.task if flight else None,
         "dynamic": flight.dynamic if flight else False,
         "aircraft": flight.aircraft if flight else None,
-        "observation_names": frames.observation_names,
+        # what the env gives; a memory's own columns are the policy's (``memory_names``)
+        "observation_names": [n for n in frames.observation_names if n not in MEMORY_NAMES],
+        "memory_names": [n for n in frames.observation_names if n in MEMORY_NAMES],
         "camera": {"view": camera, "size": image_size} if camera and image_size else None,
         "action_names": frames.action_names,
         "fps": frames.fps,

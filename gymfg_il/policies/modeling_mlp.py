@@ -1,6 +1,9 @@
-"""The MLP policy: normalised observation in, normalised action out."""
+"""The MLP policy: normalised observation in, normalised action out; with ``memory``, the
+observation extended by its loop integrals (``policies.memory``), carried as its state."""
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 import torch
@@ -29,15 +32,37 @@ class MLPPolicy(NormalizedPolicy):
             width = h
         layers.append(nn.Linear(width, n_act))
         self.net = nn.Sequential(*layers)
+        self._recipe: Any = None  # what makes the memory of a new episode, built once
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        """Normalised action predicted from raw observations (any leading dims)."""
+        """Normalised action predicted from raw observations (any leading dims); with
+        ``memory``, observations already extended by the memory's columns."""
         return self.net(self.normalized(obs))
 
     def loss(self, obs: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
         return nn.functional.mse_loss(self.forward(obs), self.action_norm(action))
 
     @torch.no_grad()
-    def act(self, obs: torch.Tensor, state: object = None) -> tuple[torch.Tensor, object]:
-        """Raw action for a batch of raw observations; no memory."""
-        return self.action_norm.inverse(self.forward(obs)), None
+    def act(self, obs: torch.Tensor, state: Any = None) -> tuple[torch.Tensor, Any]:
+        """Raw action for a batch of raw observations; with ``memory``, ``state`` is each
+        row's memory (None at an episode's start)."""
+        if self.config.memory != "none":
+            obs, state = self.remember(obs, state)
+        return self.action_norm.inverse(self.forward(obs)), state
+
+    def remember(self, obs: torch.Tensor, state: Any) -> tuple[torch.Tensor, Any]:
+        """The observations extended by their memory, and the memory carried on."""
+        if state is None:
+            state = [self.recipe().new() for _ in range(len(obs))]
+        rows = obs.detach().cpu().numpy()
+        memory = np.stack([m(row) for m, row in zip(state, rows, strict=True)])
+        return torch.cat([obs, torch.as_tensor(memory, device=obs.device)], dim=-1), state
+
+    def recipe(self) -> Any:
+        if self._recipe is None:
+            from gymfg_il.policies.memory import LoopMemoryRecipe
+
+            cfg = self.config
+            assert cfg.memory_flight is not None, "for_data fills in the memory's flight"
+            self._recipe = LoopMemoryRecipe.for_flight(cfg.memory_flight, cfg.memory_observation)
+        return self._recipe

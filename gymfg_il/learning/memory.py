@@ -1,0 +1,50 @@
+"""A policy's memory as columns of the frames it learns from (``remembered``): the loop
+integrals of ``policies.memory`` computed over each recorded episode from its first frame, as
+the policy computes them in flight step by step."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.errors import ConfigError
+from gymfg_il.learning.frames import Frames, episode_runs
+
+
+def remembered(frames: Frames, policy: Any) -> Frames:
+    """``frames`` with the memory ``policy`` (a configuration) declares appended to each
+    observation (names ``memory.*``, statistics from these frames); as they are where it
+    declares none. Computed before any frame is left out, so each episode runs whole."""
+    if getattr(policy, "memory", "none") == "none":
+        return frames
+    from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe
+
+    if any(n in NAMES for n in frames.observation_names):
+        return frames  # already remembered (DAgger's rounds hand the frames on)
+    flight, why = frames.flight()
+    if flight is None or not flight.is_solo:
+        raise ConfigError(
+            f"--memory loops runs the task's expert loops, so it needs a dataset of one solo "
+            f"flight spec: {why or 'a team flight'}; train with --memory none"
+        )
+    recipe = LoopMemoryRecipe.for_flight(flight.to_dict(), frames.observation_names)
+    memory, fresh = np.zeros((len(frames), len(NAMES)), np.float32), recipe.new()
+    first, end = episode_runs(frames.episode)
+    for start in np.unique(first):
+        stop = int(end[start])
+        if not np.array_equal(frames.frame[start:stop], np.arange(stop - start)):
+            raise ConfigError(
+                f"episode {int(frames.episode[start])} does not hold its frames 0, 1, ... in "
+                "order, so its memory cannot be run from its start; repair the dataset "
+                "(collect recover) or train with --memory none"
+            )
+        memory[start:stop] = fresh.over(frames.obs[start:stop])
+    stats = {
+        "mean": np.r_[frames.obs_stats["mean"], memory.mean(0)],
+        "std": np.r_[frames.obs_stats["std"], memory.std(0)],
+    }
+    obs = np.concatenate([frames.obs, memory], axis=1)
+    names = [*frames.observation_names, *NAMES]
+    return replace(frames, obs=obs, observation_names=names, obs_stats=stats)

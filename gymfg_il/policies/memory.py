@@ -1,0 +1,95 @@
+"""What a policy may remember as features: the integrals of the errors its task's expert loops
+track (``LoopMemory``), run on the observations the policy sees.
+
+A memoryless policy copies what a demonstrator did at each moment but not what the
+demonstrator had been accumulating: the controllers hold altitude by integrating the climb-rate
+error and the pitch error, a person by trimming. The task declares its expert's loops
+(``Task.expert()``, ``tasks.experts``); ``LoopMemory`` runs those loops (an ``Autopilot``
+whose action is thrown away) on the policy's own observations and gives their integrals, one
+number per loop, updated in O(1) per step and reset at each episode's start. Training computes
+them over each recorded episode in order (``over``), flight step by step (``__call__``): the
+same code on the same float32 observations, so both see the same numbers."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from gymfg_il.errors import ConfigError
+
+# the expert's loops whose error integrals are remembered, in feature order
+LOOPS = ("climb", "pitch", "roll", "speed", "slip")
+NAMES = tuple(f"memory.{loop}_error_integral" for loop in LOOPS)
+MEMORY_KINDS = ("none", "loops")
+
+
+@dataclass(frozen=True)
+class LoopMemoryRecipe:
+    """What makes a fresh ``LoopMemory`` (built once from a flight spec, ``for_flight``):
+    the expert's observation names, aircraft model, step and targets."""
+
+    observation_names: tuple[str, ...]
+    model: str
+    dt: float
+    targets: Any
+    gains: Any
+    throttle: float
+
+    @classmethod
+    def for_flight(
+        cls, spec: Mapping[str, Any], observation_names: Sequence[str]
+    ) -> LoopMemoryRecipe:
+        """The recipe of the expert that flies ``spec`` (a solo ``FlightSpec.to_dict()``),
+        checked to read ``observation_names``, the policy's observation."""
+        from gymfg_il.controllers.autopilot import controller_for
+        from gymfg_il.envs.flight import FlightSpec
+
+        flight = FlightSpec.from_dict(spec)
+        env = flight.make_env()
+        try:
+            names = tuple(env.task.observation_names)
+            if names != tuple(observation_names):
+                raise ConfigError(
+                    f"memory: the flight {flight.task_label} on {flight.aircraft} observes "
+                    f"{list(names)}, the policy {list(observation_names)}"
+                )
+            model, dt = env.aircraft.model, env.dt
+            pilot = controller_for(env.task, model, dt, env.aircraft.profile.cruise_throttle)
+        finally:
+            env.close()
+        return cls(names, model, dt, pilot.targets, pilot.gains, pilot.throttle_trim)
+
+    def new(self) -> LoopMemory:
+        from gymfg_il.controllers.autopilot import Autopilot
+
+        pilot = Autopilot(self.observation_names, self.model, self.dt, self.targets, self.gains)
+        pilot.set_throttle_trim(self.throttle)
+        return LoopMemory(pilot)
+
+
+class LoopMemory:
+    """The expert's loop integrals over one episode's observations (see the module)."""
+
+    names = NAMES
+
+    def __init__(self, pilot: Any) -> None:
+        self.pilot = pilot
+        self.pids = (pilot.climb_pid, pilot.pitch_pid, pilot.roll_pid, pilot.speed_pid)
+        self.pids += (pilot.slip_pid,)
+
+    def reset(self) -> None:
+        self.pilot.reset()
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        """The integrals once ``observation`` (float32, the policy's) is taken in."""
+        self.pilot.act(np.asarray(observation, dtype=np.float32))
+        return np.array([pid.integral for pid in self.pids], dtype=np.float32)
+
+    def over(self, obs: np.ndarray) -> np.ndarray:
+        """The integrals at each frame of one episode's observations (N, n_obs), in order,
+        from the episode's start."""
+        self.reset()
+        return np.stack([self(row) for row in obs]) if len(obs) else np.zeros((0, len(NAMES)))
