@@ -4,6 +4,7 @@ the policy computes them in flight step by step."""
 
 from __future__ import annotations
 
+import logging
 from dataclasses import replace
 from typing import Any
 
@@ -11,6 +12,8 @@ import numpy as np
 
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.frames import Frames, episode_runs
+
+log = logging.getLogger(__name__)
 
 
 def remembered(frames: Frames, policy: Any) -> Frames:
@@ -32,15 +35,24 @@ def remembered(frames: Frames, policy: Any) -> Frames:
     recipe = LoopMemoryRecipe.for_flight(flight.to_dict(), frames.observation_names)
     memory, fresh = np.zeros((len(frames), len(NAMES)), np.float32), recipe.new()
     first, end = episode_runs(frames.episode)
+    gaps = []
     for start in np.unique(first):
-        stop = int(end[start])
-        if not np.array_equal(frames.frame[start:stop], np.arange(stop - start)):
+        stop, numbers = int(end[start]), frames.frame[first[start] : end[start]]
+        if numbers[0] != 0 or np.any(np.diff(numbers) <= 0):
             raise ConfigError(
-                f"episode {int(frames.episode[start])} does not hold its frames 0, 1, ... in "
-                "order, so its memory cannot be run from its start; repair the dataset "
-                "(collect recover) or train with --memory none"
+                f"episode {int(frames.episode[start])} does not start at frame 0 with its "
+                "frames in order, so its memory cannot be run from its start; repair the "
+                "dataset (python -m gymfg_il.collect recover) or train with --memory none"
             )
+        if numbers[-1] != len(numbers) - 1:
+            gaps.append(int(frames.episode[start]))
         memory[start:stop] = fresh.over(frames.obs[start:stop])
+    if gaps:
+        log.warning(
+            "episodes %s lack frames (edited datasets): their memory runs over the frames "
+            "they hold, as if consecutive",
+            gaps,
+        )
     stats = {
         "mean": np.r_[frames.obs_stats["mean"], memory.mean(0)],
         "std": np.r_[frames.obs_stats["std"], memory.std(0)],

@@ -60,3 +60,10 @@ class MLPConfig(PolicyConfig):
             )
         observed = [n for n in data.observation_names if n not in NAMES]
         return replace(self, memory_flight=data.flight.to_dict(), memory_observation=observed)
+
+    @property
+    def memory_names(self) -> tuple[str, ...]:
+        """The memory's own columns, after the observation's (none without memory)."""
+        from gymfg_il.policies.memory import NAMES
+
+        return NAMES if self.memory != "none" else ()

@@ -23,8 +23,14 @@ class MLPPolicy(NormalizedPolicy):
         super().__init__(config, obs_stats, action_stats)
         self.config: MLPConfig = config
         n_obs, n_act = self.n_obs, self.n_act
+        # with memory, its columns (the last) reach the action through a linear layer alone,
+        # as a PID's integral term does: beyond the integrals the demonstrations showed (a
+        # gust), the clone answers as the loops it learned from, where an MLP's answer is
+        # anyone's guess (still-air clones crashed 5 of 8 in turbulence that way)
+        self.n_memory = len(config.memory_names) if config.memory != "none" else 0
+        self.integral = nn.Linear(self.n_memory, n_act, bias=False) if self.n_memory else None
         layers: list[nn.Module] = []
-        width = n_obs
+        width = n_obs - self.n_memory
         for h in config.hidden:
             layers += [nn.Linear(width, h), nn.GELU()]
             if config.dropout:
@@ -37,7 +43,11 @@ class MLPPolicy(NormalizedPolicy):
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         """Normalised action predicted from raw observations (any leading dims); with
         ``memory``, observations already extended by the memory's columns."""
-        return self.net(self.normalized(obs))
+        x = self.normalized(obs)
+        if self.integral is None:
+            return self.net(x)
+        k = self.n_memory
+        return self.net(x[..., :-k]) + self.integral(x[..., -k:])
 
     def loss(self, obs: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
         return nn.functional.mse_loss(self.forward(obs), self.action_norm(action))
