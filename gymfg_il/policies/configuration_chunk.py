@@ -45,6 +45,10 @@ class ChunkConfig(PolicyConfig):
         return problems
 
     @property
+    def stateful(self) -> bool:
+        return True  # in flight: its last observations and the chunks still being flown
+
+    @property
     def window(self) -> Window:
         return Window(
             observation=tuple(range(1 - self.history, 1)), action=tuple(range(self.chunk))
