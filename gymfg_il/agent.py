@@ -19,6 +19,10 @@ class Agent(Protocol):
     the aircraft may see of other teams (one row per aircraft), or is empty. An agent may also
     have ``start_from(action)``: the rollout calls it after ``reset`` with the controls the
     aircraft starts with (a trimmed start's throttle), so controllers start from the trim.
+    An agent whose ``stateful`` attribute is True carries state from step to step (a
+    recurrent policy's memory): it is reset at every episode's start and must be called at
+    every step, also where its action is not flown (a person's takeover), so that the state
+    follows the flight.
     """
 
     def reset(self, seed: int | None = None) -> None: ...

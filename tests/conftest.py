@@ -1,5 +1,6 @@
-"""Shared fixtures: small factories for envs, free UDP ports, an X server of a test's own, and
-a tiny dataset of autopilot demonstrations."""
+"""Shared fixtures: small factories for envs, free UDP ports, an X server of a test's own, a
+tiny dataset of autopilot demonstrations, and a small recurrent policy with the check that
+whoever flies it carries its state (``tiny_gru``, ``carried_state``)."""
 
 from __future__ import annotations
 
@@ -9,9 +10,12 @@ import select
 import shutil
 import socket
 import subprocess
+from pathlib import Path
 
+import numpy as np
 import pytest
 
+SAMPLE = Path(__file__).resolve().parents[1] / "datasets/sample-altitude-c172p/dataset"
 XVFB_DEADLINE_S = 180  # a loaded 2-core machine is slow; only a failure waits this long
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
@@ -103,3 +107,63 @@ def tiny_dataset(tmp_path_factory):
     result = record_autopilot(cfg)
     build_from_logs([result.log], out / "dataset")
     return out / "dataset"
+
+
+@pytest.fixture(scope="session")
+def tiny_gru(tmp_path_factory):
+    """The checkpoint folder of a small recurrent (GRU) policy trained for a few seconds on
+    the bundled sample: it flies altitude on the c172p at 10 Hz, with a memory."""
+    from gymfg_il.learning.bc import train_bc
+    from gymfg_il.learning.config import TrainConfig
+    from gymfg_il.policies.configuration_gru import GRUConfig
+
+    out = tmp_path_factory.mktemp("gru")
+    gru = GRUConfig(hidden=16, sequence_length=4)
+    train_bc(TrainConfig(dataset=SAMPLE, out=out, policy=gru, epochs=3, seed=0))
+    return out
+
+
+# Stepwise and whole-episode GRU actions differ in float32 rounding: MKL's sgemm sums a
+# single row (one step) in another order than a block of rows (the whole episode), in the
+# encoder, the GRU's input projection and the head (the recurrent projection is one row in
+# both). Measured: at most 6.0e-8 over the sample's 20 episodes of 900 steps (hidden 16 and
+# 256); 1e-6 is 8 float32 ulps at 1.0, and a state not carried (or not reset) moves the
+# actions by 1e-2 and more.
+STEP_VS_WINDOW_ATOL = 1e-6
+
+
+def _whole_episode(policy, observations, carry=True):
+    """A recurrent policy's actions for one episode's observations (steps, n_obs), clipped
+    as the rollout clips them: its module run over the whole sequence at once
+    (``policy.forward(obs[None])``), or, without ``carry``, every step from a fresh state."""
+    import torch
+
+    from gymfg_il.envs.actions import clip
+
+    obs = torch.as_tensor(np.asarray(observations, dtype=np.float32))
+    with torch.no_grad():
+        pred, _ = policy.forward(obs[None] if carry else obs[:, None])
+        raw = policy.action_norm.inverse(pred[0] if carry else pred[:, 0])
+    return np.array([clip(a) for a in raw.double().numpy()])
+
+
+@pytest.fixture(scope="session")
+def carried_state():
+    """``carried_state(policy, observations, actions, flown=None)`` asserts that ``actions``
+    (clipped), flown over one whole episode, are what the recurrent ``policy`` gives with its
+    state fresh at the episode's first step and carried through every step (the GRU over the
+    whole sequence at once), and that this could fail: without the state carried they
+    differ. ``flown``: the steps whose action was the policy's (a person flew the others;
+    their observations still count). Returns the largest difference."""
+
+    def check(policy, observations, actions, flown=None):
+        assert len(observations) == len(actions) > 1
+        mask = np.ones(len(actions), bool) if flown is None else np.asarray(flown, bool)
+        whole = _whole_episode(policy, observations)[mask]
+        gap = float(np.abs(np.asarray(actions)[mask] - whole).max())
+        assert gap <= STEP_VS_WINDOW_ATOL, f"the flown actions are {gap:.3g} off"
+        stateless = _whole_episode(policy, observations, carry=False)[mask]
+        assert np.abs(stateless - whole).max() > 1e3 * STEP_VS_WINDOW_ATOL
+        return gap
+
+    return check

@@ -12,8 +12,11 @@ from gymfg_il.manual.controller import ManualController
 class Takeover:
     """An Agent: the person (``human``) flies, or ``assistant`` while the person lets it.
 
-    While the person flies, an assistant with ``track`` follows their inputs, so handing back
-    is bumpless; ``intervening`` tells the rollout loop to flag those steps.
+    While the person flies, the assistant is still called at every step where it keeps
+    something from step to step, its action discarded: a ``stateful`` one (a recurrent
+    policy) so its state follows the flight, one with ``track`` (the controller) so its
+    integrators follow the person's inputs; handing back is then bumpless.
+    ``intervening`` tells the rollout loop to flag those steps.
     """
 
     def __init__(self, human: ManualController, assistant: Agent | None = None) -> None:
@@ -48,9 +51,12 @@ class Takeover:
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
         if self.human_flies:
             action = self.human.act(observation)
-            track = getattr(self.assistant, "track", None)
-            if self.assistant is not None and track is not None:
-                self.assistant.act(observation)
+            assistant = self.assistant
+            track = getattr(assistant, "track", None)
+            keeps = track is not None or getattr(assistant, "stateful", False)
+            if assistant is not None and keeps:  # something of it outlives the step
+                assistant.act(observation, opponent_states)  # its action is not flown
+            if track is not None:
                 track(action)  # its integrators follow the person: a bumpless hand-back
             return action
         assert self.assistant is not None

@@ -1,5 +1,5 @@
 """A trained policy as an Agent: numpy observation in, action out, memory reset at every
-episode."""
+episode (a policy whose configuration is ``stateful`` carries it from step to step)."""
 
 from __future__ import annotations
 
@@ -22,7 +22,10 @@ class PolicyAgent:
         self.policy, self.meta, self.device = policy, meta, device
         self.observation_names: list[str] = list(meta["observation_names"])
         self._torch = torch
-        self._state: object = None
+        self._state: object = None  # what the policy carries to its next step (None: fresh)
+        # it carries state across steps: call it at every step, also where its action is not
+        # flown (``Agent``), so the state follows the flight
+        self.stateful: bool = bool(policy.config.stateful)
         # a vision policy's eyes: the env's camera of the current state (``AgentSpec.make``)
         self.camera: dict[str, Any] | None = meta.get("camera")
         self.see: Callable[[], np.ndarray] | None = None

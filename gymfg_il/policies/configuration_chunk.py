@@ -46,7 +46,7 @@ class ChunkConfig(PolicyConfig):
 
     @property
     def stateful(self) -> bool:
-        return True  # the history and the chunks being flown
+        return True  # in flight: its last observations and the chunks still being flown
 
     @property
     def window(self) -> Window:

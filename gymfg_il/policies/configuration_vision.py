@@ -152,6 +152,10 @@ class VisionConfig(PolicyConfig):
         return problems
 
     @property
+    def stateful(self) -> bool:
+        return True  # in flight: its last frames and the integrals of the errors it estimated
+
+    @property
     def window(self) -> Window:
         return Window(images=tuple(range(1 - self.frames, 1)), camera=self.camera, pool=self.pool)
 

@@ -129,6 +129,9 @@ class LeRobotAgent:
         self._torch = torch
         self._columns: list[int] = []
         self.see: dict[str, Callable[[], np.ndarray]] = {}
+        # LeRobot's policies queue observations and actions across steps (``reset`` empties
+        # the queues): called at every step, also where a person flies (``Agent``)
+        self.stateful = True
 
     @property
     def name(self) -> str:

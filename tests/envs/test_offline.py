@@ -11,7 +11,7 @@ from gymfg_il.envs import OfflineEnv
 from gymfg_il.envs.scenarios import formation, head_on_merge
 from gymfg_il.errors import ActionError, ConfigError, EnvStateError
 from gymfg_il.sim.initial import InitialConditions
-from gymfg_il.tasks import DummyTask, LevelFlightTask, geometry
+from gymfg_il.tasks import DummyTask, LevelFlightTask, ReachStaticTargetAltitudeTask, geometry
 
 
 def paper_loop(env, team, agents, seed=0):
@@ -256,3 +256,21 @@ def test_head_on_merge_points_teams_at_each_other():
     assert angle_difference_deg(geometry.bearing_deg(b, r), b.heading_deg) == pytest.approx(
         0, abs=0.5
     )
+
+
+def test_an_opponent_flown_by_a_recurrent_policy_carries_its_state_and_starts_afresh(
+    tiny_gru, carried_state
+):
+    from gymfg_il.policies.agent import PolicyAgent
+    from gymfg_il.rollout import Rollout
+
+    red = Team("red", [(c172p("red-1"), ReachStaticTargetAltitudeTask)], episode_time_s=5)
+    blue = Team("blue", [(c172p("blue-1"), ReachStaticTargetAltitudeTask)], episode_time_s=5)
+    gru = PolicyAgent.load(tiny_gru)
+    env = OfflineEnv([(blue, [gru])])
+    rollout = Rollout(env, [ConstantAgent()], team=red)
+    for seed in (0, 1):  # the env resets its agents at every episode's start
+        flown = rollout.episode(seed).trajectories["blue-1"]
+        assert len(flown) == 50
+        carried_state(gru.policy, flown.observations, flown.actions)
+    env.close()

@@ -127,3 +127,23 @@ def test_recover_rebuilds_every_episode_of_a_dagger_session_and_names_what_it_ca
     err = capsys.readouterr().err
     assert "3 episode(s) are lost" in err and f"{base_log.name} episode 2 (ego)" in err
     assert summary(session / "dataset")[0] == 2  # the DAgger episodes alone
+
+
+def test_dagger_flies_a_recurrent_policy_with_its_state_carried_and_reset(
+    tiny_gru, tmp_path, carried_state
+):
+    from gymfg_il.policies.agent import PolicyAgent
+    from gymfg_il.recording.reader import read_log
+
+    history = run_dagger(
+        tiny_gru, tmp_path / "dagger", iterations=1, episodes=2, train_overrides={"epochs": 1}
+    )
+    (log_path,) = (tmp_path / "dagger" / "logs").glob("dagger-*.mcap")
+    episodes = read_log(log_path).complete_episodes
+    policy = PolicyAgent.load(tiny_gru).policy
+    assert len(episodes) == 2
+    for episode in episodes:  # one kept agent flew both, the expert labelled every step
+        steps = episode.steps["ego"]
+        carried_state(policy, steps.observation, steps.action)
+        assert np.abs(steps.label - steps.action).max() > 0.01
+    assert PolicyAgent.load(history[-1].policy).stateful  # retrained as the GRU it was

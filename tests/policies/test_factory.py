@@ -43,6 +43,10 @@ class LinearConfig(PolicyConfig):
         return [] if self.previous >= 1 else [f"previous={self.previous} must be >= 1"]
 
     @property
+    def stateful(self) -> bool:
+        return True  # in flight it keeps the observations before
+
+    @property
     def window(self) -> Window:
         return Window(observation=tuple(range(1 - self.previous, 1)))
 
@@ -125,3 +129,30 @@ def test_the_builtin_types_are_found_by_name():
     for name, ptype in factory.policy_types().items():
         assert ptype.config.type == name
         assert ptype.config().to_dict()["type"] == name
+
+
+SMALL = {
+    "mlp": {"hidden": [8]},
+    "gru": {"hidden": 8},
+    "chunk": {"hidden": [8], "history": 2, "chunk": 3},
+    "ppo": {"hidden": [8]},
+}
+
+
+@pytest.mark.parametrize("name", ["mlp", "gru", "chunk", "vision", "ppo"])
+def test_a_type_is_stateful_exactly_when_its_act_carries_state(name):
+    """Every consumer honours ``stateful`` (resets the state, calls the policy at every
+    step): a type whose ``act`` hands back a state must say so."""
+    names = ["roll_deg", "roll_deg_target", "roll_deg_error"]
+    unit = {"mean": np.zeros(3), "std": np.ones(3)}
+    if name == "vision":
+        config = factory.policy_type(name).config.for_observation(
+            names, image_size=16, pool=1, channels=[4], hidden=[8]
+        )
+        inputs = (torch.zeros(1, 16, 16, 3, dtype=torch.uint8), torch.zeros(1, 3))
+    else:
+        config = factory.make_config(name, **SMALL[name])
+        inputs = torch.zeros(1, 3)
+    policy = factory.make_policy(config, unit, {"mean": np.zeros(4), "std": np.ones(4)})
+    _, state = policy.eval().act(inputs, None)
+    assert config.stateful == (state is not None)

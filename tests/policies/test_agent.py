@@ -1,0 +1,45 @@
+"""A trained policy as an Agent (``policies.agent``): a recurrent one carries its state from
+step to step, the same state at every step (O(1) work), and starts every episode afresh."""
+
+from pathlib import Path
+
+import numpy as np
+
+from gymfg_il.envs.actions import clip
+from gymfg_il.learning.data import load_frames
+from gymfg_il.policies.agent import PolicyAgent
+
+SAMPLE = Path(__file__).resolve().parents[2] / "datasets/sample-altitude-c172p/dataset"
+
+
+def sample_episodes(n):
+    """The observations of the bundled sample's first ``n`` episodes (900 steps each)."""
+    frames = load_frames(SAMPLE)
+    return [frames.obs[frames.episode == e] for e in np.unique(frames.episode)[:n]]
+
+
+def fly(agent, observations):
+    return np.array([clip(agent.act(o)) for o in observations])
+
+
+def test_a_recurrent_agent_steps_as_its_gru_runs_over_the_whole_episode(tiny_gru, carried_state):
+    (episode,) = sample_episodes(1)
+    agent = PolicyAgent.load(tiny_gru)
+    assert agent.stateful
+    actions = [clip(agent.act(episode[0]))]
+    size = agent._state.shape  # the GRU's hidden state, one per layer
+    actions += [clip(agent.act(o)) for o in episode[1:]]
+    assert agent._state.shape == size == (1, 1, 16)  # as large at the end: O(1) per step
+    carried_state(agent.policy, episode, np.array(actions))
+
+
+def test_reset_starts_the_next_episode_as_a_fresh_agent_would(tiny_gru):
+    first, second = sample_episodes(2)
+    agent = PolicyAgent.load(tiny_gru)
+    fly(agent, first)
+    unreset = fly(agent, second[:1])
+    agent.reset()
+    again = fly(agent, second)
+    fresh = fly(PolicyAgent.load(tiny_gru), second)
+    assert np.array_equal(again, fresh)  # bit for bit: the same computation
+    assert np.abs(unreset[0] - fresh[0]).max() > 1e-3  # the memory of the first episode
