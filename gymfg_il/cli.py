@@ -90,6 +90,7 @@ def add_fields(
     overrides_only: bool = False,
 ) -> None:
     """One flag per field of the dataclass ``cls`` (``only``/``skip`` choose the fields;
+    ``only`` also takes one whose metadata keeps it off most commands, ``cli=False``;
     ``defaults`` and ``flags`` change a field's default and flag name for this command;
     ``shown`` says in words what a field left out means, e.g. "the policy's";
     ``overrides_only``: a flag left out is absent from the namespace, e.g. recipe overrides)."""
@@ -99,8 +100,8 @@ def add_fields(
     for f in dataclasses.fields(cls):
         if f.name in skip or (only is not None and f.name not in only):
             continue
-        if not f.metadata.get("cli", True):
-            continue
+        if not f.metadata.get("cli", True) and (only is None or f.name not in only):
+            continue  # a field kept off the command line, unless a command asks for it
         default = defaults.get(f.name, _default(f))
         flag = flags.get(f.name) or f.metadata.get("flag") or "--" + f.name.replace("_", "-")
         text = docs.get(f.name, "")

@@ -31,6 +31,8 @@ if TYPE_CHECKING:
 
 EPILOG = __doc__.split("\n\n", 1)[1]
 # a person's session: at the manual rate, until they quit, into a folder of its own
+# flight options that only a manual session takes from the command line
+MANUAL_ONLY = ("gusts",)
 MANUAL_DEFAULTS = {"agent_hz": MANUAL_HZ, "episodes": 0, "out": Path("datasets/manual")}
 
 
@@ -71,6 +73,7 @@ def _recipe_parser() -> argparse.ArgumentParser:
     )
     r.add_argument("recipe", type=Path)
     cli.add_fields(r, ManualConfig, overrides_only=True)
+    cli.add_fields(r, ManualConfig, only=MANUAL_ONLY, overrides_only=True)
     r.add_argument(
         "--fps", dest="agent_hz", type=int, default=cli.SUPPRESS, help="the same as --agent-hz"
     )
@@ -108,11 +111,11 @@ def _flying(sub: Any) -> None:
     cli.add_fields(
         manual,
         ManualConfig,
-        skip=("noise",),  # the autopilot's
         defaults={**unset, **MANUAL_DEFAULTS},
         shown=shown,
         flags={"agent_hz": "--fps"},
     )
+    cli.add_fields(manual, ManualConfig, only=MANUAL_ONLY, shown={"gusts": "none"})
     manual.add_argument(
         "--no-progress", action="store_true", help="no progress bar (--pilot synthetic)"
     )
@@ -204,10 +207,8 @@ def _autopilot(args: argparse.Namespace) -> int:
         options = {k: v for k, v in vars(args).items() if k in known}
         cfg = CollectConfig.from_recipe(args.recipe, **options)
         if isinstance(cfg, ManualConfig):
-            if "noise" in options or args.workers != 1 or args.ray:
-                raise ConfigError(
-                    "--noise, --workers and --ray apply to autopilot recipes, not manual"
-                )
+            if args.workers != 1 or args.ray:  # (its --noise is the synthetic pilot's)
+                raise ConfigError("--workers and --ray apply to autopilot recipes, not manual")
             return _fly_by_hand(cfg, not args.no_progress)
     else:
         cfg = cli.build(CollectConfig, args)

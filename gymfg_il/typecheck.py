@@ -18,6 +18,8 @@ from typing import Any, Literal
 def _name(kind: Any) -> str:
     if typing.get_origin(kind) is Literal:
         return " or ".join(repr(c) for c in typing.get_args(kind))
+    if typing.get_origin(kind) in (typing.Union, types.UnionType):  # None: an option left unset
+        return " or ".join(_name(a) for a in typing.get_args(kind) if a is not type(None))
     return getattr(kind, "__name__", str(kind).replace("typing.", ""))
 
 

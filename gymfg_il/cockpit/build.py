@@ -90,12 +90,19 @@ def build(
     camera = Camera(320, 320, view=pilot_view, legible=True) if pilot_view and draw else None
     human = _controller(config, env, window_size(camera is not None))
     takeover = Takeover(human, _assistant(config.assist, flight, env))
-    rollout = Rollout(env, [takeover])
+    # DART noise on what the synthetic pilot flies (drawn from each episode's seed); the
+    # label stays its own answer (``rollout.loop``)
+    rollout = Rollout(env, [takeover], noise=config.noise)
     person = "synthetic" if synthetic else "human"
     assistant = _assistant_name(config.assist)
     source = person if assistant is None else f"{assistant}+{person}"
     record = session_record(
-        flight, source, device=human.device, images=images, image_size=config.image_size
+        flight,
+        source,
+        device=human.device,
+        noise=config.noise,
+        images=images,
+        image_size=config.image_size,
     )
     log = _flight_log(config, env, flight, record, source, realtime)
     updater = DatasetUpdater(config.out)
@@ -232,4 +239,5 @@ def _flight_log(
         realtime=realtime,
         gusty=flight.gusty,
         throttle=env.aircraft.profile.cruise_throttle,
+        sim=env.world.slots[0].sim,
     )

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,7 +21,11 @@ from gymfg_il.display.briefing import Debrief, debrief_of
 from gymfg_il.recording.recorder import new_log_path
 from gymfg_il.recording.writer import TrajectoryWriter
 from gymfg_il.rollout.records import Start, Tick
+from gymfg_il.sim.gusts import gust_records
 from gymfg_il.tasks.verdicts import EpisodeVerdict
+
+if TYPE_CHECKING:
+    from gymfg_il.sim.simulation import Simulation
 
 
 class FlightLog:
@@ -38,6 +42,7 @@ class FlightLog:
         realtime: keep the wall clock and the timing (a person's session).
         gusty: the flight is in turbulence (the task's verdict allows for it).
         throttle: the throttle of ``last_action`` before the first step.
+        sim: the aircraft's simulation, whose reset drew the episode's gusts (None: none).
     """
 
     def __init__(
@@ -52,10 +57,11 @@ class FlightLog:
         realtime: bool,
         gusty: bool,
         throttle: float,
+        sim: Simulation | None = None,
     ) -> None:
         self.out, self.record, self.task, self.dt = out, record, task, dt
         self.source, self.pilot_name, self.realtime = source, pilot_name, realtime
-        self.gusty = gusty
+        self.gusty, self.sim = gusty, sim
         self.writer: TrajectoryWriter | None = None
         self.last_action = np.array([0.0, 0.0, 0.0, throttle])  # what was flown last
         self.debrief: Debrief | None = None  # the last episode's verdict
@@ -71,14 +77,19 @@ class FlightLog:
         return self.writer
 
     def start(self, seed: int, starts: list[Start]) -> None:
-        """An episode begins (the rollout was just reset with ``seed``)."""
+        """An episode begins (the rollout was just reset with ``seed``); its start event lists
+        the gusts its air will blow (``sim.gusts``), if any."""
         self.verdict = EpisodeVerdict.of(self.task, self.dt, self.gusty)  # its plan now drawn
         self.verdict.start(starts[0].state)
         self._return = 0.0
         self.debrief = None
         self.steps = self.interventions = 0
         self.timing = EpisodeTiming(self.dt)
-        self._writer().start_episode(seed, starts, source=self.source, pilot=self.pilot_name)
+        gusts = self.sim.gusts if self.sim is not None else ()
+        blown = {"gusts": gust_records(gusts)} if gusts else {}
+        self._writer().start_episode(
+            seed, starts, source=self.source, pilot=self.pilot_name, **blown
+        )
 
     def log(
         self, tick: Tick, observation: np.ndarray, read_at: float, period: float | None

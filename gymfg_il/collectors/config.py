@@ -17,7 +17,7 @@ import math
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views
 from gymfg_il.envs.options import FlightOptions
@@ -53,6 +53,7 @@ class CollectConfig(FlightOptions):
     out: Path = Path("datasets/autopilot")
     images: list[str] = field(default_factory=list)
     image_size: int = DEFAULT_IMAGE_SIZE
+    logs_gusts: ClassVar[bool] = False  # each episode's gust events go to its log
 
     def __post_init__(self) -> None:
         typed = type_problems(self)
@@ -87,6 +88,11 @@ class CollectConfig(FlightOptions):
             problems.append(problem)
         if not (math.isfinite(self.noise) and self.noise >= 0):
             problems.append(f"noise={self.noise!r} must be a number >= 0")
+        if self.gusts not in (None, "none") and not self.logs_gusts:
+            problems.append(
+                f"gusts={self.gusts!r}: gust events are flown and logged in manual sessions "
+                "(collect manual --gusts); an autopilot's data shows recoveries with --noise"
+            )
         try:
             check_views(self.images)
         except ConfigError as err:
@@ -149,6 +155,10 @@ class ManualConfig(CollectConfig):
             flying through the same keyboard, joystick or mouse; it runs headless and as fast
             as the machine allows; its episodes are source=synthetic).
         skill: the synthetic pilot's level, 0 (a novice) to 1 (an ace).
+        noise: the synthetic pilot only: DART-style noise, the std of Gaussian noise added
+            to the surfaces it flies, drawn from each episode's seed; the dataset keeps the
+            pilot's own action as the label, so its episodes show recoveries from the
+            deviations; 0 = none. A person shows recoveries with --gusts instead.
         pilot_name: who flies this session, stored with each episode (the card lists pilots,
             ``train bc --select pilot=NAME`` picks theirs); default: ``synthetic-<skill>``
             for the synthetic pilot, none for a person.
@@ -165,12 +175,14 @@ class ManualConfig(CollectConfig):
     view: list[int] = field(default_factory=list, metadata={"repeat": True})
     pilot: Literal["person", "synthetic"] = "person"
     skill: float = 0.7
+    noise: float = 0.0  # a person's flight is not perturbed
     pilot_name: str | None = None
     pilot_view: Literal["front", "chase", "none"] = "front"
     keyboard: dict[str, Any] = field(default_factory=dict)
     mouse: dict[str, Any] = field(default_factory=dict)
     joystick: dict[str, Any] = field(default_factory=dict)
     flightgear: dict[str, Any] = field(default_factory=dict)
+    logs_gusts: ClassVar[bool] = True
 
     def fewest_episodes(self) -> int:
         """A person may fly until they quit (0); the synthetic pilot flies as many as asked."""
@@ -181,6 +193,12 @@ class ManualConfig(CollectConfig):
         problems += [f"view port {p}: want 1..65535" for p in self.view if not 0 < p < 65536]
         if not 0.0 <= self.skill <= 1.0:
             problems.append(f"skill={self.skill}: want 0 (a novice) .. 1 (an ace)")
+        if self.noise and self.pilot != "synthetic":
+            problems.append(
+                f"noise={self.noise!r} perturbs the synthetic pilot's controls, not a "
+                "person's; add --pilot synthetic, or drop --noise and fly --gusts LEVEL to "
+                "show recoveries"
+            )
         name = self.pilot_name
         problem = None if name is None else name_problem(name, "pilot name")
         if problem is None and name is not None and "|" in name:

@@ -8,6 +8,7 @@ markup or blow the card up, and none can stop the card from being written.
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from collections import Counter
@@ -132,6 +133,36 @@ def _pilots(episodes: dict[str, list[Any]]) -> str:
     )
 
 
+def _gusts(records: list[Any] | None) -> list[tuple[str, str]]:
+    """The gusts row of a dataset whose episodes flew in gusts (``sim.gusts``): how many,
+    how strong and how long; none for one without them."""
+    if records is None:
+        return []
+    peaks, lengths, episodes = [], [], 0
+    for record in records:
+        try:
+            gusts = json.loads(record)
+        except (TypeError, ValueError):
+            continue
+        episodes += 1
+        for gust in gusts if isinstance(gusts, list) else []:
+            if isinstance(gust, dict):
+                axes = [as_float(gust.get(f"{a}_fps"), 0.0) for a in ("north", "east", "down")]
+                peaks.append(math.hypot(*axes))
+                lengths.append(as_float(gust.get("duration_s"), 0.0))
+    if not peaks:
+        return [("gusts", f"none blew in {episodes} episode(s)")]
+    return [
+        (
+            "gusts",
+            f"{len(peaks)} in {episodes} episode(s), peaks {min(peaks):.0f}-{max(peaks):.0f} "
+            f"ft/s, {min(lengths):.1f}-{max(lengths):.1f} s long, drawn from each episode's "
+            "seed; each episode's (start_s, duration_s, north/east/down_fps) are its "
+            "`gymfg/gusts` and its log's start event",
+        )
+    ]
+
+
 def jsbsim(episodes: dict[str, list[Any]]) -> str:
     recorded = sorted({cell(v) for v in episodes.get("gymfg/jsbsim", []) if v})
     return ", ".join(recorded) or (
@@ -152,6 +183,7 @@ def facts(meta: Any, episodes: dict[str, list[Any]], specs: list[Any]) -> list[t
     weather = {
         f"turbulence {s.turbulence}, wind {s.wind_kt:g} kt"
         + (f" from {s.wind_from_deg:g} deg" if s.wind_from_deg is not None else "")
+        + (f", {s.gusts} gusts" if s.gusts != "none" else "")
         for s in specs
     }
     starts = {"trimmed straight, level flight" if s.trimmed_starts else "untrimmed" for s in specs}
@@ -177,6 +209,7 @@ def facts(meta: Any, episodes: dict[str, list[Any]], specs: list[Any]) -> list[t
             counted(episodes.get("gymfg/noise", [])) if known else "unknown",
         ),
         ("weather", "; ".join(sorted(weather)) or "unknown"),
+        *_gusts(episodes.get("gymfg/gusts")),
         ("starts", ", ".join(sorted(starts)) or "unknown"),
         ("episode ends", counted(ends) if ends else "not recorded"),
         ("verdicts", _verdicts(episodes.get("gymfg/success", []))),

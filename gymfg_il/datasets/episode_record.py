@@ -60,7 +60,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
     flown (``spec``: the flight spec, JSON; ``target``: ``target_record``), who flew it and
     how it went (``pilot``; ``success``: the task's verdict, 1 or 0, -1 where it was not
     judged, with ``verdict`` in words; ``grade``: the task's (``tasks.grades``), or "";
-    ``mark``: the pilot's own, or "")."""
+    ``mark``: the pilot's own, or ""; ``gusts``: those blown, in a gusty flight)."""
     start, end = episode.start, episode.end or {}
     target = episode.start_of(callsign).get("target")
     info = log.aircraft(callsign)
@@ -88,7 +88,18 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "log_episode": int(episode.index),
         "spec": log.spec.to_json(),
         "jsbsim": str(log.session.get("versions", {}).get("jsbsim", "")),
+        **_gusts(log, start),
     }
+
+
+def _gusts(log: Log, start: dict[str, Any]) -> dict[str, Any]:
+    """A gusty flight's ``gusts`` column: the episode's gusts (``sim.gusts``) as JSON, a list
+    of {start_s, duration_s, north_fps, east_fps, down_fps}; none for a flight without them
+    (whose dataset is as it was before gusts existed)."""
+    if log.spec.gusts == "none":
+        return {}
+    gusts = start.get("gusts")
+    return {"gusts": json.dumps(gusts if isinstance(gusts, list) else [])}
 
 
 def _timing(end: dict[str, Any]) -> dict[str, Any]:

@@ -32,6 +32,7 @@ from gymfg_il.envs.roster import AircraftSpec, TeamSpec, plain, teams_from_recor
 from gymfg_il.envs.scenarios import Scenario, scenario_from_record, scenario_record
 from gymfg_il.envs.team import Team
 from gymfg_il.errors import ConfigError, GymFGError, join_problems
+from gymfg_il.sim.gusts import GustLevel
 from gymfg_il.sim.properties import DEFAULT_OPPONENT_VIEW, indices
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, episode_steps, substeps
 from gymfg_il.sim.weather import Turbulence, Weather
@@ -65,6 +66,8 @@ class FlightSpec:
             episode; ``sim.weather``).
         wind_kt: a steady wind (knots).
         wind_from_deg: where the wind blows from (true; None: drawn per episode).
+        gusts: none, light, moderate or severe: discrete gusts, seeded per episode
+            (``sim.gusts``); recorded only when there are some.
         trimmed_starts: the tasks' and scenarios' starts are trimmed straight, level flight
             (``sim.initial.InitialConditions.trimmed``). A record without it was flown before
             trimmed starts existed and reads as False, so its episodes replay as flown.
@@ -80,6 +83,7 @@ class FlightSpec:
     wind_kt: float = 0.0
     wind_from_deg: float | None = None
     trimmed_starts: bool = True
+    gusts: GustLevel = "none"
 
     def __post_init__(self) -> None:
         problems: list[str] = []
@@ -172,12 +176,12 @@ class FlightSpec:
 
     @property
     def weather(self) -> Weather:
-        return Weather(self.turbulence, self.wind_kt, self.wind_from_deg)
+        return Weather(self.turbulence, self.wind_kt, self.wind_from_deg, self.gusts)
 
     @property
     def gusty(self) -> bool:
-        """Whether the flight is in turbulence (``Weather.gusty``): its episodes are judged
-        allowing for gusts (``tasks.verdicts``)."""
+        """Whether the flight is in turbulence or gusts (``Weather.gusty``): its episodes are
+        judged allowing for them (``tasks.verdicts``)."""
         return self.weather.gusty
 
     @property
@@ -222,7 +226,7 @@ class FlightSpec:
             "wind_kt": self.wind_kt,
             "wind_from_deg": self.wind_from_deg,
             "trimmed_starts": self.trimmed_starts,
-        }
+        } | ({"gusts": self.gusts} if self.gusts != "none" else {})  # records before gusts
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), sort_keys=True)
@@ -294,6 +298,7 @@ class FlightSpec:
             wind_kt=weather.wind_kt,
             wind_from_deg=weather.wind_from_deg,
             trimmed_starts=config.trimmed_starts,
+            gusts=weather.gusts,
         )
 
     def rebuild_problems(self) -> list[str]:

@@ -28,6 +28,7 @@ from gymfg_il.envs.config import EnvConfig
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.envs.roster import AircraftSpec, TeamSpec
 from gymfg_il.errors import ConfigError
+from gymfg_il.sim.gusts import GustLevel
 from gymfg_il.sim.weather import Turbulence, Weather
 from gymfg_il.tasks.library import task_class
 
@@ -39,7 +40,7 @@ AIRCRAFT_OPTIONS = {
     "dynamic": "dynamic",
     "task_kwargs": "task_kwargs",
 }
-WEATHER_OPTIONS = ("turbulence", "wind_kt", "wind_from_deg")
+WEATHER_OPTIONS = ("turbulence", "wind_kt", "wind_from_deg", "gusts")
 TASK_OWN_TIME = (
     "the task's own: 90 s for most, 120 for waypoints, 180 for approach (on the c172p; "
     "the turns, waypoints and formation last longer on aircraft that turn slower)"
@@ -64,6 +65,9 @@ class FlightOptions:
         sim_hz: JSBSim rate in Hz.
         wind_from_deg: where the wind blows from (true; None: drawn per episode).
         trimmed_starts: start in trimmed straight, level flight, or untrimmed (False).
+        gusts: seeded gust events to recover from: none, light, moderate or severe (peaks
+            of 5-20, 20-35, 35-50 ft/s, 1-4 s long, one every 8-16, 6-12, 4-8 s; drawn
+            from each episode's seed, listed in the log and the dataset; ``sim.gusts``).
     """
 
     aircraft: str | None = None
@@ -77,6 +81,8 @@ class FlightOptions:
     sim_hz: int | None = field(default=None, metadata={"cli": False})
     wind_from_deg: float | None = field(default=None, metadata={"cli": False})
     trimmed_starts: bool | None = field(default=None, metadata={"cli": False})
+    # a flag of `collect manual` only (a person's recoveries), where the log lists them
+    gusts: GustLevel | None = field(default=None, metadata={"cli": False})
 
     @classmethod
     def of(cls, flight: FlightSpec) -> FlightOptions:

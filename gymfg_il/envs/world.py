@@ -161,7 +161,7 @@ class World:
         for slot in self.slots:
             key = zlib.crc32(slot.callsign.encode())
             # the air gets a stream of its own: calm episodes draw exactly what they always did
-            air = weather.draw(np.random.default_rng([base, 2, key]))
+            air = weather.draw(np.random.default_rng([base, 2, key]), self.max_steps * self.dt)
             own = np.random.default_rng([base, 1 + key])
             ic = ics.get(slot.callsign) or self._start(slot.task.initial_conditions(own))
             throttle = slot.aircraft.profile.cruise_throttle

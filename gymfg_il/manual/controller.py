@@ -82,7 +82,10 @@ class ManualController:
         self.values = np.array([0.0, 0.0, 0.0, throttle])
         self.start_controls = self.values.copy()  # this episode's (a trimmed start's trim)
         self.neutral: np.ndarray = np.zeros(3)  # the surfaces' neutral: the start controls
-        self.held: set[str] = set()
+        # the keys held down, in the order they were pressed (a dict as an ordered set): the
+        # contributions of keys on one axis add up in that order, the same in every process
+        # (a set's order follows string hashes, which PYTHONHASHSEED varies)
+        self.held: dict[str, None] = {}
         self.joysticks: dict[int, Any] = {}  # instance id -> pygame Joystick (or None)
         self.status = ""
         k = self.keys
@@ -156,11 +159,11 @@ class ManualController:
         commands: list[str] = []
         for ev in events:
             if ev.type == pg.KEYDOWN:
-                self.held.add(pg.key.name(ev.key))
+                self.held.setdefault(pg.key.name(ev.key))
                 if pg.key.name(ev.key) in self.keys.center:
                     self.values[:3] = self.neutral
             elif ev.type == pg.KEYUP:
-                self.held.discard(pg.key.name(ev.key))
+                self.held.pop(pg.key.name(ev.key), None)
             elif ev.type == pg.MOUSEMOTION and self.device == "mouse":
                 self._mouse(ev.pos)
             elif self.device == "joystick":

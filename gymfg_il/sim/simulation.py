@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.aircraft import jsbsim_root, resolve_model
+from gymfg_il.sim.gusts import GUST_AXES, Gust, gust_at
 from gymfg_il.sim.initial import InitialConditions
 from gymfg_il.sim.properties import CATALOGUE, StateVar
 from gymfg_il.sim.timing import DEFAULT_AGENT_HZ, DEFAULT_SIM_HZ, substeps
@@ -82,6 +83,9 @@ class Simulation:
             for p in ("fcs/aileron-cmd-norm", "fcs/elevator-cmd-norm", "fcs/rudder-cmd-norm")
         ]
         self._set_aileron, self._set_elevator, self._set_rudder = setters
+        self._set_gust = [node(f"atmosphere/gust-{a}-fps").set_double_value for a in GUST_AXES]
+        self.gusts: tuple[Gust, ...] = ()  # the last reset's air's gusts (``sim.gusts``)
+        self._frame = 0  # JSBSim steps since the last reset (the gusts' clock)
         self._set_throttles: list[Callable[[float], None]] = [
             node(f"fcs/throttle-cmd-norm[{i}]").set_double_value for i in range(self.engines)
         ]
@@ -135,6 +139,7 @@ class Simulation:
         finally:
             os.remove(path)
         air.before_reset(fdm)
+        self.gusts, self._frame = air.gusts, 0
         for prop in self._mixtures:
             fdm[prop] = 1.0
         self.apply(*controls, run=False)
@@ -195,10 +200,21 @@ class Simulation:
         self._set_rudder(rudder)
         for set_throttle in self._set_throttles:
             set_throttle(throttle)
-        if run:
+        if run and self.gusts:
+            self._run_gusts()
+        elif run:
             step = self._run
             for _ in self._substep_range:
                 step()
+
+    def _run_gusts(self) -> None:
+        """One agent step with the gusts blowing, set anew at every JSBSim step."""
+        for _ in self._substep_range:
+            wind = gust_at(self.gusts, self._frame / self.sim_hz)
+            for set_axis, value in zip(self._set_gust, wind, strict=True):
+                set_axis(value)
+            self._run()
+            self._frame += 1
 
     def read(self) -> np.ndarray:
         """The catalogue's values now, as a new float64 vector."""

@@ -10,6 +10,8 @@ per episode so that a run in turbulence reproduces bit for bit.
 
 (the reference values of JSBSim's FGWinds, after the milspec's figures 7 and 9). The wind
 blows from ``wind_from_deg`` (true), or from a direction drawn per episode when it is None.
+Discrete gust events (``gusts``, ``sim.gusts``) are drawn per episode after the rest, so an
+episode without them draws exactly what it did before they existed.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from typing import Any, Literal
 import numpy as np
 
 from gymfg_il.errors import ConfigError
+from gymfg_il.sim.gusts import GUST_AXES, GUSTS, Gust, GustLevel, draw_gusts
 from gymfg_il.units import KT_TO_FPS, wrap_360
 
 # turbulence -> (JSBSim turb-type, severity index, wind speed at 20 ft in ft/s)
@@ -40,11 +43,14 @@ class Weather:
     turbulence: Turbulence = "none"
     wind_kt: float = 0.0
     wind_from_deg: float | None = None
+    gusts: GustLevel = "none"
 
     def __post_init__(self) -> None:
         problems = []
         if self.turbulence not in TURBULENCE:
             problems.append(f"turbulence={self.turbulence!r}: choose {', '.join(TURBULENCE)}")
+        if self.gusts not in GUSTS:
+            problems.append(f"gusts={self.gusts!r}: choose {', '.join(GUSTS)}")
         speed = self.wind_kt
         if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not 0 <= speed < 200:
             problems.append(f"wind_kt={speed!r} must be a number in [0, 200) knots")
@@ -58,15 +64,17 @@ class Weather:
 
     @property
     def gusty(self) -> bool:
-        """Whether the air is turbulent (a verdict then allows for gusts: ``tasks.verdicts``)."""
-        return self.turbulence != "none"
+        """Whether the air is turbulent or gusty (a verdict then allows for gusts:
+        ``tasks.verdicts``)."""
+        return self.turbulence != "none" or self.gusts != "none"
 
     @property
     def calm(self) -> bool:
         return not self.gusty and not self.wind_kt
 
-    def draw(self, rng: np.random.Generator) -> Air:
-        """This episode's air (the turbulence seed, the wind's direction if it has none)."""
+    def draw(self, rng: np.random.Generator, episode_s: float = 0.0) -> Air:
+        """This episode's air (the turbulence seed, the wind's direction if it has none, the
+        gusts of an episode of ``episode_s`` seconds)."""
         kind, severity, w20 = TURBULENCE[self.turbulence]
         seed = int(rng.integers(2**31)) if kind else 0
         origin = self.wind_from_deg
@@ -74,7 +82,9 @@ class Weather:
             origin = float(rng.uniform(0.0, 360.0)) if self.wind_kt else 0.0
         speed = self.wind_kt * KT_TO_FPS
         toward = math.radians(origin + 180.0)  # a wind from the north blows south
-        return Air(kind, severity, w20, seed, speed * math.cos(toward), speed * math.sin(toward))
+        north, east = speed * math.cos(toward), speed * math.sin(toward)
+        gusts = draw_gusts(self.gusts, episode_s, rng)  # last: calm air draws what it did
+        return Air(kind, severity, w20, seed, north, east, gusts)
 
 
 @dataclass(frozen=True)
@@ -87,6 +97,7 @@ class Air:
     seed: int = 0
     wind_north_fps: float = 0.0
     wind_east_fps: float = 0.0
+    gusts: tuple[Gust, ...] = ()
 
     @property
     def wind(self) -> tuple[float, float]:
@@ -94,7 +105,8 @@ class Air:
 
     def before_reset(self, fdm: Any) -> None:
         """Turbulence (it survives the reset) and the wind of the initial conditions (the
-        reset hands it to the atmosphere); calm air clears both."""
+        reset hands it to the atmosphere); calm air clears both, and any gust left blowing
+        (the simulation blows this air's gusts as it steps)."""
         fdm["atmosphere/turb-type"] = self.turb_type
         fdm["atmosphere/turbulence/milspec/severity"] = self.severity
         fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = self.w20_fps
@@ -102,3 +114,5 @@ class Air:
         north, east = self.wind
         fdm["ic/vw-mag-fps"] = math.hypot(north, east)
         fdm["ic/vw-dir-deg"] = wrap_360(math.degrees(math.atan2(east, north)))  # blows toward
+        for axis in GUST_AXES:
+            fdm[f"atmosphere/gust-{axis}-fps"] = 0.0

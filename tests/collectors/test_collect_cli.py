@@ -170,11 +170,15 @@ def test_recipe_overrides_take_each_kind_its_own_flags(capsys):
 
     recipes = Path(__file__).resolve().parents[2] / "collectors"
     args = collect.parse_args([str(recipes / "manual-keyboard.toml"), "--fps", "10"])
-    assert args.agent_hz == 10 and "noise" not in vars(args)
+    assert args.agent_hz == 10 and "noise" not in vars(args) and "gusts" not in vars(args)
     assert collect.main([str(recipes / "sample.toml"), "--device", "mouse"]) == 2
     assert "apply to manual recipes" in capsys.readouterr().err
-    assert collect.main([str(recipes / "manual-keyboard.toml"), "--noise", "0.1"]) == 2
+    assert collect.main([str(recipes / "manual-keyboard.toml"), "--workers", "2"]) == 2
     assert "apply to autopilot recipes" in capsys.readouterr().err
+    # a person is not perturbed: --noise is the synthetic pilot's (tests/collectors/
+    # test_recoveries.py flies it)
+    assert collect.main([str(recipes / "manual-keyboard.toml"), "--noise", "0.1"]) == 2
+    assert "add --pilot synthetic" in capsys.readouterr().err
 
 
 def test_running_a_recipe_again_remakes_its_dataset_instead_of_doubling_it(tmp_path, capsys):

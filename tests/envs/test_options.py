@@ -67,7 +67,8 @@ def test_the_flags_keep_their_names_and_defaults():
     manual = vars(collect.parse_args(["manual", "--fps", "60"]))
     assert (manual["agent_hz"], manual["episodes"]) == (60, 0)
     assert str(manual["out"]) == "datasets/manual"
-    assert "noise" not in manual and manual["device"] == "keyboard"
+    assert manual["noise"] == 0.0 and manual["device"] == "keyboard"  # the synthetic pilot's
+    assert manual["gusts"] is None and "gusts" not in auto  # a manual session's option
     assert all(vars(evaluate.parse_args([]))[k] is None for k in (*flight, "wind_kt"))
     given = vars(evaluate.parse_args(["--episode-time", "30", "--turbulence", "severe"]))
     assert (given["episode_time_s"], given["turbulence"]) == (30.0, "severe")
