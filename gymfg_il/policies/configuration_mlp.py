@@ -42,6 +42,14 @@ class MLPConfig(PolicyConfig):
             problems.append(f"dropout={self.dropout!r} must lie in [0, 1)")
         return problems
 
+    def to_dict(self) -> dict[str, Any]:
+        """Without memory, written as before memory existed (older readers load it)."""
+        out = super().to_dict()
+        if self.memory == "none":
+            for name in ("memory", "memory_flight", "memory_observation"):
+                out.pop(name)
+        return out
+
     @property
     def stateful(self) -> bool:
         return self.memory != "none"
