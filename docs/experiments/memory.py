@@ -8,9 +8,10 @@ action from the step's previous action alone, by least squares over every flown 
 controller's own beside it).
 
     python docs/experiments/memory.py OUT [--cases 5-demos gusts] [--tasks altitude heading]
-        [--noise 0.05 0.2] [--variants mlp loops chunk gru] [--episodes 16] [--seed 7000]
+        [--noise 0.05 0.2] [--variants mlp vertical loops chunk gru] [--episodes 16] [--seed 7000]
 
-Variants: `mlp` (no memory), `loops` (`--memory loops`), `chunk` (an observation window of 8
+Variants: `mlp` (no memory), `vertical` (`--memory vertical`: the climb-rate and pitch
+loops), `loops` (`--memory loops`: every loop), `chunk` (an observation window of 8
 steps, one action: `--policy chunk --history 8 --chunk 1`), `gru` (`--policy gru`,
 20 epochs: its default 60 takes ~20 min per case on two cores).
 """
@@ -34,6 +35,7 @@ CASES = {
 }
 VARIANTS = {
     "mlp": [],
+    "vertical": ["--memory", "vertical"],
     "loops": ["--memory", "loops"],
     "chunk": ["--policy", "chunk", "--history", "8", "--chunk", "1"],
     "gru": ["--policy", "gru", "--epochs", "20"],

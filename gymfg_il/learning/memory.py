@@ -22,18 +22,20 @@ def remembered(frames: Frames, policy: Any) -> Frames:
     declares none. Computed before any frame is left out, so each episode runs whole."""
     if getattr(policy, "memory", "none") == "none":
         return frames
-    from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe
+    from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe, names_of
 
     if any(n in NAMES for n in frames.observation_names):
         return frames  # already remembered (DAgger's rounds hand the frames on)
     flight, why = frames.flight()
     if flight is None or not flight.is_solo:
         raise ConfigError(
-            f"--memory loops runs the task's expert loops, so it needs a dataset of one solo "
+            f"--memory {policy.memory} runs the task's expert loops, so it needs a dataset of one solo "
             f"flight spec: {why or 'a team flight'}; train with --memory none"
         )
     recipe = LoopMemoryRecipe.for_flight(flight.to_dict(), frames.observation_names)
-    memory, fresh = np.zeros((len(frames), len(NAMES)), np.float32), recipe.new()
+    kind = policy.memory
+    fresh = recipe.new(kind)
+    memory = np.zeros((len(frames), len(fresh.names)), np.float32)
     first, end = episode_runs(frames.episode)
     gaps = []
     for start in np.unique(first):
@@ -58,5 +60,5 @@ def remembered(frames: Frames, policy: Any) -> Frames:
         "std": np.r_[frames.obs_stats["std"], memory.std(0)],
     }
     obs = np.concatenate([frames.obs, memory], axis=1)
-    names = [*frames.observation_names, *NAMES]
+    names = [*frames.observation_names, *names_of(kind)]
     return replace(frames, obs=obs, observation_names=names, obs_stats=stats)

@@ -30,7 +30,7 @@ class MLPConfig(PolicyConfig):
 
     hidden: list[int] = field(default_factory=lambda: [256, 256])
     dropout: float = 0.0
-    memory: Literal["none", "loops"] = "none"
+    memory: Literal["none", "vertical", "loops"] = "none"
     memory_flight: dict[str, Any] | None = field(default=None, metadata=DERIVED)
     memory_observation: list[str] = field(default_factory=list, metadata=DERIVED)
 
@@ -63,7 +63,7 @@ class MLPConfig(PolicyConfig):
 
         if data.flight is None or not data.flight.is_solo:
             raise ConfigError(
-                "--memory loops runs the task's expert loops, so it needs a dataset of one "
+                f"--memory {self.memory} runs the task's expert loops, so it needs a dataset of one "
                 "solo flight spec (this one has none, or several); train with --memory none"
             )
         observed = [n for n in data.observation_names if n not in NAMES]
@@ -72,6 +72,6 @@ class MLPConfig(PolicyConfig):
     @property
     def memory_names(self) -> tuple[str, ...]:
         """The memory's own columns, after the observation's (none without memory)."""
-        from gymfg_il.policies.memory import NAMES
+        from gymfg_il.policies.memory import names_of
 
-        return NAMES if self.memory != "none" else ()
+        return names_of(self.memory)

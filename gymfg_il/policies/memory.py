@@ -20,10 +20,18 @@ import numpy as np
 
 from gymfg_il.errors import ConfigError
 
-# the expert's loops whose error integrals are remembered, in feature order
-LOOPS = ("climb", "pitch", "roll", "speed", "slip")
-NAMES = tuple(f"memory.{loop}_error_integral" for loop in LOOPS)
-MEMORY_KINDS = ("none", "loops")
+# the expert's loops whose error integrals each kind of memory holds, in feature order
+LOOPS = {
+    "none": (),
+    "vertical": ("climb", "pitch"),  # what holds an altitude: climb rate, then pitch
+    "loops": ("climb", "pitch", "roll", "speed", "slip"),
+}
+NAMES = tuple(f"memory.{loop}_error_integral" for loop in LOOPS["loops"])
+
+
+def names_of(kind: str) -> tuple[str, ...]:
+    """The feature names of a kind of memory (``LOOPS``)."""
+    return tuple(f"memory.{loop}_error_integral" for loop in LOOPS[kind])
 
 
 @dataclass(frozen=True)
@@ -62,23 +70,21 @@ class LoopMemoryRecipe:
             env.close()
         return cls(names, model, dt, pilot.targets, pilot.gains, pilot.throttle_trim)
 
-    def new(self) -> LoopMemory:
+    def new(self, kind: str = "loops") -> LoopMemory:
         from gymfg_il.controllers.autopilot import Autopilot
 
         pilot = Autopilot(self.observation_names, self.model, self.dt, self.targets, self.gains)
         pilot.set_throttle_trim(self.throttle)
-        return LoopMemory(pilot)
+        return LoopMemory(pilot, LOOPS[kind])
 
 
 class LoopMemory:
     """The expert's loop integrals over one episode's observations (see the module)."""
 
-    names = NAMES
-
-    def __init__(self, pilot: Any) -> None:
+    def __init__(self, pilot: Any, loops: Sequence[str] = LOOPS["loops"]) -> None:
         self.pilot = pilot
-        self.pids = (pilot.climb_pid, pilot.pitch_pid, pilot.roll_pid, pilot.speed_pid)
-        self.pids += (pilot.slip_pid,)
+        self.pids = tuple(getattr(pilot, f"{loop}_pid") for loop in loops)
+        self.names = tuple(f"memory.{loop}_error_integral" for loop in loops)
 
     def reset(self) -> None:
         self.pilot.reset()
@@ -92,4 +98,4 @@ class LoopMemory:
         """The integrals at each frame of one episode's observations (N, n_obs), in order,
         from the episode's start."""
         self.reset()
-        return np.stack([self(row) for row in obs]) if len(obs) else np.zeros((0, len(NAMES)))
+        return np.stack([self(row) for row in obs]) if len(obs) else np.zeros((0, len(self.pids)))

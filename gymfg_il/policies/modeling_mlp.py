@@ -63,7 +63,7 @@ class MLPPolicy(NormalizedPolicy):
     def remember(self, obs: torch.Tensor, state: Any) -> tuple[torch.Tensor, Any]:
         """The observations extended by their memory, and the memory carried on."""
         if state is None:
-            state = [self.recipe().new() for _ in range(len(obs))]
+            state = [self.recipe().new(self.config.memory) for _ in range(len(obs))]
         rows = obs.detach().cpu().numpy()
         memory = np.stack([m(row) for m, row in zip(state, rows, strict=True)])
         return torch.cat([obs, torch.as_tensor(memory, device=obs.device)], dim=-1), state
