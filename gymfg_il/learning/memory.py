@@ -19,22 +19,45 @@ log = logging.getLogger(__name__)
 def remembered(frames: Frames, policy: Any) -> Frames:
     """``frames`` with the memory ``policy`` (a configuration) declares appended to each
     observation (names ``memory.*``, statistics from these frames); as they are where it
-    declares none. Computed before any frame is left out, so each episode runs whole."""
-    if getattr(policy, "memory", "none") == "none":
+    declares none, or (``auto``) where the dataset is not of one solo flight with an expert.
+    Computed before any frame is left out, so each episode runs whole."""
+    asked = getattr(policy, "memory", "none")
+    if asked == "none":
         return frames
-    from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe, names_of
+    from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe, kind_for, names_of
 
     if any(n in NAMES for n in frames.observation_names):
         return frames  # already remembered (DAgger's rounds hand the frames on)
     flight, why = frames.flight()
-    if flight is None or not flight.is_solo:
-        raise ConfigError(
-            f"--memory {policy.memory} runs the task's expert loops, so it needs a dataset of one solo "
-            f"flight spec: {why or 'a team flight'}; train with --memory none"
-        )
-    recipe = LoopMemoryRecipe.for_flight(flight.to_dict(), frames.observation_names)
-    kind = policy.memory
-    fresh = recipe.new(kind)
+    try:
+        if flight is None or not flight.is_solo:
+            raise ConfigError(
+                f"--memory {asked} runs the task's expert loops, so it needs a dataset of one "
+                f"solo flight spec: {why or 'a team flight'}; train with --memory none"
+            )
+        recipe = LoopMemoryRecipe.for_flight(flight.to_dict(), frames.observation_names)
+        kind = kind_for(recipe.targets) if asked == "auto" else asked
+        if kind == "none":
+            log.info("the policy remembers nothing: %s holds its start altitude", flight.task)
+            return frames
+        memory = _columns(frames, recipe.new(kind))
+    except ConfigError as err:
+        if asked != "auto":
+            raise
+        log.warning("the policy remembers nothing (--memory none): %s", err)
+        return frames
+    stats = {
+        "mean": np.r_[frames.obs_stats["mean"], memory.mean(0)],
+        "std": np.r_[frames.obs_stats["std"], memory.std(0)],
+    }
+    obs = np.concatenate([frames.obs, memory], axis=1)
+    names = [*frames.observation_names, *names_of(kind)]
+    return replace(frames, obs=obs, observation_names=names, obs_stats=stats)
+
+
+def _columns(frames: Frames, fresh: Any) -> np.ndarray:
+    """The memory ``fresh`` (a ``LoopMemory``) at every frame, run over each episode from
+    its first frame."""
     memory = np.zeros((len(frames), len(fresh.names)), np.float32)
     first, end = episode_runs(frames.episode)
     gaps = []
@@ -55,10 +78,4 @@ def remembered(frames: Frames, policy: Any) -> Frames:
             "they hold, as if consecutive",
             gaps,
         )
-    stats = {
-        "mean": np.r_[frames.obs_stats["mean"], memory.mean(0)],
-        "std": np.r_[frames.obs_stats["std"], memory.std(0)],
-    }
-    obs = np.concatenate([frames.obs, memory], axis=1)
-    names = [*frames.observation_names, *names_of(kind)]
-    return replace(frames, obs=obs, observation_names=names, obs_stats=stats)
+    return memory

@@ -22,15 +22,20 @@ class MLPConfig(PolicyConfig):
     Attributes:
         hidden: widths of the hidden layers.
         dropout: dropout after each hidden layer (0 = none).
-        memory: `loops`: the policy also sees the integrals of the errors its task's expert
-            loops track (climb rate, pitch, roll, airspeed, slip), run on its own
-            observations from the episode's start, so it can hold what a demonstrator
-            integrates (trim, PID integrals); `none`: the observation alone.
+        memory: what the policy remembers besides the observation: the integrals of the
+            errors its task's expert loops track, run on its own observations from the
+            episode's start, so it can hold what a demonstrator integrates (trim, PID
+            integrals). `vertical`: the climb-rate and pitch loops (what holds an
+            altitude); `loops`: every loop (also roll, airspeed, slip); `none`: the
+            observation alone; `auto`: `vertical` where the task's expert follows a
+            vertical target the task observes (altitude, pitch, turn, climb-turn, waypoints,
+            formation, approach), `none` where it holds the start altitude (roll, heading,
+            airspeed, sideslip, level) or the dataset is not of one solo flight.
     """
 
     hidden: list[int] = field(default_factory=lambda: [256, 256])
     dropout: float = 0.0
-    memory: Literal["none", "vertical", "loops"] = "none"
+    memory: Literal["auto", "none", "vertical", "loops"] = "auto"
     memory_flight: dict[str, Any] | None = field(default=None, metadata=DERIVED)
     memory_observation: list[str] = field(default_factory=list, metadata=DERIVED)
 
@@ -43,35 +48,43 @@ class MLPConfig(PolicyConfig):
         return problems
 
     def to_dict(self) -> dict[str, Any]:
-        """Without memory, written as before memory existed (older readers load it)."""
+        """Without memory, no flight or observation of it; ``auto`` (not yet chosen for a
+        dataset) written as before memory existed."""
         out = super().to_dict()
-        if self.memory == "none":
-            for name in ("memory", "memory_flight", "memory_observation"):
-                out.pop(name)
+        if not self.memory_names:
+            out.pop("memory_flight")
+            out.pop("memory_observation")
+        if self.memory == "auto":
+            out.pop("memory")
         return out
 
     @property
     def stateful(self) -> bool:
-        return self.memory != "none"
+        return bool(self.memory_names)
 
     def for_data(self, data: DatasetInfo) -> MLPConfig:
-        """With ``memory``, the flight the expert loops are taken from and the observation
-        they read (the dataset's, less the memory's own columns)."""
-        if self.memory == "none":
-            return self
-        from gymfg_il.policies.memory import NAMES
+        """With memory, the kind the data holds (``learning.memory.remembered`` appended its
+        columns), the flight its loops are taken from and the observation they read."""
+        from gymfg_il.policies.memory import NAMES, kind_of
 
-        if data.flight is None or not data.flight.is_solo:
+        kind = kind_of(data.observation_names)
+        if self.memory not in ("auto", kind):
             raise ConfigError(
-                f"--memory {self.memory} runs the task's expert loops, so it needs a dataset of one "
-                "solo flight spec (this one has none, or several); train with --memory none"
+                f"--memory {self.memory}: the frames hold the memory {kind!r}; train on "
+                "frames that learning.memory.remembered extended for this configuration"
             )
+        if kind == "none":
+            return replace(self, memory="none")
+        assert data.flight is not None, "remembered needs a flight"
         observed = [n for n in data.observation_names if n not in NAMES]
-        return replace(self, memory_flight=data.flight.to_dict(), memory_observation=observed)
+        return replace(
+            self, memory=kind, memory_flight=data.flight.to_dict(), memory_observation=observed
+        )
 
     @property
     def memory_names(self) -> tuple[str, ...]:
-        """The memory's own columns, after the observation's (none without memory)."""
+        """The memory's own columns, after the observation's (none without memory, or
+        before ``for_data`` has chosen it)."""
         from gymfg_il.policies.memory import names_of
 
-        return names_of(self.memory)
+        return names_of(self.memory) if self.memory != "auto" else ()

@@ -34,6 +34,25 @@ def names_of(kind: str) -> tuple[str, ...]:
     return tuple(f"memory.{loop}_error_integral" for loop in LOOPS[kind])
 
 
+def kind_for(targets: Any) -> str:
+    """The memory a task's expert (its ``Targets``) calls for by default: `vertical` where its
+    vertical loop follows a target the task observes (an altitude, a glidepath, a slot, a
+    pitch), `none` where it only holds the start altitude (roll, heading, airspeed, ...):
+    there the still-air demonstrations barely move the vertical integrals, the clone's weights
+    on them are guesses, and in turbulence a heading clone with them crashed 3 of 16
+    (docs/results/memory.md)."""
+    return "vertical" if isinstance(targets.vertical_source, str) else "none"
+
+
+def kind_of(observation_names: Sequence[str]) -> str:
+    """The kind of memory whose columns end ``observation_names`` ("none": no memory)."""
+    held = tuple(n for n in observation_names if n in NAMES)
+    for kind in LOOPS:
+        if held == names_of(kind):
+            return kind
+    raise ConfigError(f"memory columns {list(held)} are no kind of memory ({', '.join(LOOPS)})")
+
+
 @dataclass(frozen=True)
 class LoopMemoryRecipe:
     """What makes a fresh ``LoopMemory`` (built once from a flight spec, ``for_flight``):

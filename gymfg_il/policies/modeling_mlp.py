@@ -27,7 +27,7 @@ class MLPPolicy(NormalizedPolicy):
         # as a PID's integral term does: beyond the integrals the demonstrations showed (a
         # gust), the clone answers as the loops it learned from, where an MLP's answer is
         # anyone's guess (still-air clones crashed 5 of 8 in turbulence that way)
-        self.n_memory = len(config.memory_names) if config.memory != "none" else 0
+        self.n_memory = len(config.memory_names)
         self.integral = nn.Linear(self.n_memory, n_act, bias=False) if self.n_memory else None
         layers: list[nn.Module] = []
         width = n_obs - self.n_memory
@@ -56,7 +56,7 @@ class MLPPolicy(NormalizedPolicy):
     def act(self, obs: torch.Tensor, state: Any = None) -> tuple[torch.Tensor, Any]:
         """Raw action for a batch of raw observations; with ``memory``, ``state`` is each
         row's memory (None at an episode's start)."""
-        if self.config.memory != "none":
+        if self.n_memory:
             obs, state = self.remember(obs, state)
         return self.action_norm.inverse(self.forward(obs)), state
 

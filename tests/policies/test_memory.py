@@ -15,7 +15,7 @@ from gymfg_il.learning.memory import remembered
 from gymfg_il.policies.agent import PolicyAgent
 from gymfg_il.policies.configuration import DatasetInfo
 from gymfg_il.policies.configuration_mlp import MLPConfig
-from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe
+from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe, names_of
 from gymfg_il.rollout import Rollout
 
 
@@ -94,12 +94,33 @@ def test_the_memory_reaches_the_action_linearly(remembering):
         assert torch.allclose(f(x + a + b) - f(x + a), f(x + b) - f(x), atol=1e-4)
 
 
-def test_memory_needs_one_solo_flight_and_whole_episodes(tiny_dataset):
+def test_memory_needs_one_solo_flight_and_whole_episodes(tiny_dataset, caplog):
+    frames = load_frames(tiny_dataset)
+    frames.episodes = {}  # no flight spec
     with pytest.raises(ConfigError, match="--memory none"):
-        MLPConfig(memory="loops").for_data(DatasetInfo(["a"], 10, None))
+        remembered(frames, MLPConfig(memory="vertical"))
+    assert remembered(frames, MLPConfig()) is frames  # auto: nothing, and says so
+    assert "remembers nothing" in caplog.text
     frames = load_frames(tiny_dataset)
     frames.frame = frames.frame + 1  # no episode starts at frame 0
     with pytest.raises(ConfigError, match="frame 0"):
         remembered(frames, MLPConfig(memory="loops"))
     with pytest.raises(ConfigError, match="memory"):
         MLPConfig(memory="forever")
+    with pytest.raises(ConfigError, match="frames hold the memory 'none'"):
+        MLPConfig(memory="loops").for_data(DatasetInfo(["a"], 10, None))
+
+
+def test_auto_remembers_the_vertical_loops_and_says_which(tiny_dataset):
+    frames = remembered(load_frames(tiny_dataset), MLPConfig())
+    assert frames.observation_names[-2:] == list(names_of("vertical"))
+    spec, _ = frames.flight()
+    config = MLPConfig().for_data(DatasetInfo(frames.observation_names, 10, spec))
+    assert config.memory == "vertical" and config.stateful
+    assert config.memory_observation == frames.observation_names[:-2]
+    assert MLPConfig(memory="none").for_data(DatasetInfo(["a"], 10, None)).to_dict() == {
+        "type": "mlp",
+        "hidden": [256, 256],
+        "dropout": 0.0,
+        "memory": "none",
+    }
