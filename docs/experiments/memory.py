@@ -34,7 +34,7 @@ CASES = {
     "gusts": (10, "none", "moderate"),
 }
 VARIANTS = {
-    "mlp": [],
+    "mlp": ["--memory", "none"],
     "vertical": ["--memory", "vertical"],
     "loops": ["--memory", "loops"],
     "chunk": ["--policy", "chunk", "--history", "8", "--chunk", "1"],

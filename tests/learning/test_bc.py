@@ -35,7 +35,8 @@ def test_loss_falls_and_checkpoint_is_complete(trained):
         assert (trained.out / name).is_file()
     meta = json.loads((trained.out / "config.json").read_text())
     assert meta["task"] == "altitude" and meta["aircraft"] == "c172p" and meta["type"] == "mlp"
-    assert len(meta["obs_stats"]["mean"]) == len(meta["observation_names"])
+    remembered = [*meta["observation_names"], *meta["memory_names"]]  # the memory: the policy's
+    assert len(meta["obs_stats"]["mean"]) == len(remembered) == len(meta["observation_names"]) + 2
 
 
 def test_training_is_reproducible_with_a_seed(trained, tiny_dataset, tmp_path):
