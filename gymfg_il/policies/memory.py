@@ -108,6 +108,15 @@ class LoopMemory:
     def reset(self) -> None:
         self.pilot.reset()
 
+    @property
+    def bounds(self) -> np.ndarray:
+        """How far each integral can go either way: its loop's anti-windup clamp (``PID``:
+        what the output range can use; 0 for a loop without an integral term)."""
+        return np.array(
+            [(p.out_max - p.out_min) / abs(p.ki) if p.ki else 0.0 for p in self.pids],
+            dtype=np.float32,
+        )
+
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         """The integrals once ``observation`` (float32, the policy's) is taken in."""
         self.pilot.act(np.asarray(observation, dtype=np.float32))

@@ -3,6 +3,8 @@ observation extended by its loop integrals (``policies.memory``), carried as its
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -63,10 +65,20 @@ class MLPPolicy(NormalizedPolicy):
     def remember(self, obs: torch.Tensor, state: Any) -> tuple[torch.Tensor, Any]:
         """The observations extended by their memory, and the memory carried on."""
         if state is None:
-            state = [self.recipe().new(self.config.memory) for _ in range(len(obs))]
+            fresh = self.memory_maker()
+            assert fresh is not None, "remember is called with memory only"
+            state = [fresh() for _ in range(len(obs))]
         rows = obs.detach().cpu().numpy()
         memory = np.stack([m(row) for m, row in zip(state, rows, strict=True)])
         return torch.cat([obs, torch.as_tensor(memory, device=obs.device)], dim=-1), state
+
+    def memory_maker(self) -> Callable[[], Any] | None:
+        """What makes the fresh memory of an episode (a ``LoopMemory``), or None without
+        memory: picklable, so an env in another process (PPO's, ``rl.envs.Remembering``)
+        computes the memory with the code and the numbers this policy flies with."""
+        if self.config.memory == "none":
+            return None
+        return partial(self.recipe().new, self.config.memory)
 
     def recipe(self) -> Any:
         if self._recipe is None:

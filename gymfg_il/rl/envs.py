@@ -1,6 +1,7 @@
 """The envs PPO trains in: the policy's own flight, taking actions in the policy's normalised
-units (``normalized_actions``), its reward what ``rl.reward`` composes (``make_env``); and
-the vector env that samples them (``training_envs``): stable-baselines3's own, or the grouped
+units (``normalized_actions``), its reward what ``rl.reward`` composes, its observation
+extended by the policy's memory where it has one (``Remembering``) (``make_env``); and the
+vector env that samples them (``training_envs``): stable-baselines3's own, or the grouped
 sampler (``rl.grouped``).
 """
 
@@ -44,18 +45,51 @@ class _Denormalize:
         return raw
 
 
+class Remembering(gym.ObservationWrapper):
+    """``env``'s observation extended by a policy's memory (``policies.memory``), as the
+    policy extends it in flight (``MLPPolicy.remember``): a fresh memory from ``fresh`` (the
+    policy's ``memory_maker``) at each reset, then the observation (as float32) followed by
+    the memory once it has taken that observation in, within its bounds (``LoopMemory``)."""
+
+    def __init__(self, env: gym.Env, fresh: Callable[[], Any]) -> None:
+        super().__init__(env)
+        self.fresh = fresh
+        self.memory = fresh()
+        box = env.observation_space
+        assert isinstance(box, gym.spaces.Box) and len(box.shape) == 1, box
+        bound = self.memory.bounds
+        low = np.r_[box.low, -bound].astype(np.float32)
+        high = np.r_[box.high, bound].astype(np.float32)
+        self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
+
+    def reset(self, **kwargs: Any) -> tuple[np.ndarray, dict[str, Any]]:
+        self.memory = self.fresh()  # as the policy starts each episode: a new memory
+        return super().reset(**kwargs)
+
+    def observation(self, observation: np.ndarray) -> np.ndarray:
+        obs = np.asarray(observation, dtype=np.float32)
+        return np.concatenate([obs, self.memory(obs)])
+
+
 def make_env(
-    spec: dict[str, Any], mean: list[float], std: list[float], success_bonus: float = 0.0
+    spec: dict[str, Any],
+    mean: list[float],
+    std: list[float],
+    success_bonus: float = 0.0,
+    memory: Callable[[], Any] | None = None,
 ) -> gym.Env:
     """One training env (picklable, built in its own process): the flight ``spec`` taking
     actions in the policy's normalised units, its episodes' task returns logged
     (stable-baselines3's ``Monitor``, ``rollout/ep_rew_mean``), its reward with the success
-    bonus (``rl.reward.per_env``)."""
+    bonus (``rl.reward.per_env``); with ``memory`` (the policy's ``memory_maker``), its
+    observation extended by the memory (``Remembering``, outermost: the reward judges the
+    flight's own observation)."""
     from stable_baselines3.common.monitor import Monitor
 
     flight = FlightSpec.from_dict(spec)
     env = normalized_actions(flight.make_env(), np.array(mean), np.array(std))
-    return reward.per_env(Monitor(env), success_bonus)
+    env = reward.per_env(Monitor(env), success_bonus)
+    return env if memory is None else Remembering(env, memory)
 
 
 def training_envs(env_fn: Callable[[], gym.Env], n: int, sampler: str = "grouped") -> Any:

@@ -3,7 +3,10 @@
 The actor *is* the MLP policy (``policies.modeling_mlp``): the same network and the same
 normalisation, its output the mean of PPO's Gaussian, in the MLP's normalised action units.
 The env takes actions in those units (``rl.envs.normalized_actions``), so before any
-update PPO's mean action is, bit for bit, the action the cloned policy flies.
+update PPO's mean action is, bit for bit, the action the cloned policy flies. A policy with a
+memory (``train bc --memory``) gets its observation extended by the memory from its envs
+(``rl.envs.Remembering``), as it extends it itself in flight: the actor, gSDE's noise features
+and the critic all see that extended observation.
 
 Two things keep the first updates from undoing the cloning:
 

@@ -109,6 +109,7 @@ def _learn(cfg: PPORunConfig, start: Start, callback: Any, tensorboard: Path) ->
         action["mean"].tolist(),
         action["std"].tolist(),
         cfg.ppo.success_bonus,
+        module.memory_maker(),  # None without memory: the flight's observation alone
     )
     venv = training_envs(env_fn, cfg.n_envs, cfg.sampler)
     venv.seed(cfg.seed)  # env k's first reset takes seed + k

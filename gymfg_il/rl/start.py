@@ -55,7 +55,8 @@ def _cloned(cfg: PPORunConfig) -> Start:
     if kind not in INIT_TYPES:
         raise ConfigError(
             f"--init {cfg.init} is a {kind} policy; PPO fine-tunes MLP policies only, for now "
-            "(train one with `train bc --policy mlp`)"
+            "(train one with `train bc --policy mlp`; an MLP carries a memory of its task's "
+            "loops with --memory vertical or loops, which PPO keeps)"
         )
     if not meta.get("spec"):
         raise ConfigError(
@@ -157,16 +158,26 @@ def stats_of(module: Any, name: str) -> dict[str, np.ndarray]:
 
 def as_ppo(actor: Any) -> Any:
     """A copy of the actor on the CPU, in eval mode, whose config is a ``ppo`` policy's (its
-    network)."""
+    network and its memory, which a policy flown computes itself)."""
     from gymfg_il.policies.configuration_ppo import PPOConfig
 
     module = copy.deepcopy(actor).cpu().eval()
-    module.config = PPOConfig(hidden=list(actor.config.hidden))
+    own = actor.config
+    module.config = PPOConfig(
+        hidden=list(own.hidden),
+        memory=own.memory,
+        memory_flight=own.memory_flight,
+        memory_observation=list(own.memory_observation),
+    )
     return module
 
 
 def meta_of(start: Start) -> dict[str, Any]:
-    """What the result keeps of the starting policy's config.json: what it observes and acts
-    on, its rate, and its data and BC run (DAgger trains the result again on them)."""
+    """What the result keeps of the starting policy's config.json: what it observes (and,
+    with a memory, the memory's own columns) and acts on, its rate, and its data and BC run
+    (DAgger trains the result again on them)."""
     keep = ("observation_names", "action_names", "fps", "dataset", "train", "camera")
-    return {k: start.meta[k] for k in keep if k in start.meta}
+    meta = {k: start.meta[k] for k in keep if k in start.meta}
+    if start.meta.get("memory_names"):  # a policy without memory: its config.json as before
+        meta["memory_names"] = start.meta["memory_names"]
+    return meta

@@ -250,12 +250,13 @@ def test_what_cannot_be_fine_tuned_is_refused(bc_policy, tiny_dataset, tmp_path)
         starting_policy(PPORunConfig(init=bc_policy, task="heading"))
     with pytest.raises(ConfigError, match=r"--agent-hz 30: .* flies agent_hz 10"):
         starting_policy(PPORunConfig(init=bc_policy, agent_hz=30))
-    gru = tmp_path / "gru"
-    train_bc(
-        TrainConfig(dataset=tiny_dataset, out=gru, epochs=1, policy=make_config("gru", hidden=8))
-    )
-    with pytest.raises(ConfigError, match="gru policy; PPO fine-tunes MLP policies only"):
-        starting_policy(PPORunConfig(init=gru))
+    # a policy whose state is not an MLP's memory (a recurrent state, a chunk's queue)
+    for kind, settings in (("gru", {"hidden": 8}), ("chunk", {"hidden": [8], "chunk": 2})):
+        out = tmp_path / kind
+        policy = make_config(kind, **settings)
+        train_bc(TrainConfig(dataset=tiny_dataset, out=out, epochs=1, policy=policy))
+        with pytest.raises(ConfigError, match=f"{kind} policy; PPO fine-tunes MLP .*--memory"):
+            starting_policy(PPORunConfig(init=out))
 
 
 def test_a_ppo_policy_retrains_as_an_mlp(bc_policy):

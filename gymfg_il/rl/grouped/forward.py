@@ -87,6 +87,10 @@ class NumpyActorCritic:
 
         self.actor_norm, self.critic_norm = stats(actor.obs_norm), stats(critic.obs_norm)
         self.actor, self.critic = layers(actor.net), layers(critic.net)
+        # a memory's columns (the last) reach the mean through a linear layer alone
+        # (``MLPPolicy.forward``)
+        integral = actor.integral
+        self.integral = None if integral is None else integral.weight.detach().numpy().T.copy()
         self.std = np.exp(self.policy.log_std.detach().numpy())  # (n_obs, n_act)
 
     def reset_noise(self, n: int) -> None:
@@ -103,10 +107,17 @@ class NumpyActorCritic:
         all a step needs (``score`` values a whole rollout's steps at once, afterwards)."""
         mean, std = self.actor_norm
         z = (obs - mean) / std
-        mu = _run(self.actor, z)
+        mu = self._mean(z)
         assert self.noise is not None, "reset_noise before sampling"
         action = mu + np.matmul(z[:, None, :], self.noise)[:, 0, :]
         return action.astype(np.float32), mu
+
+    def _mean(self, z: np.ndarray) -> np.ndarray:
+        """The actor's mean for the normalised observations ``z``."""
+        if self.integral is None:
+            return _run(self.actor, z)
+        k = len(self.integral)
+        return _run(self.actor, z[:, :-k]) + z[:, -k:] @ self.integral
 
     def score(
         self, obs: np.ndarray, actions: np.ndarray, mu: np.ndarray

@@ -23,14 +23,22 @@ from gymfg_il.rl.grouped.sampling import sampling_copy
 from gymfg_il.rl.model import make_model
 
 
-def _policy(tmp_path):
+def _policy(tmp_path, memory="none"):
+    """A policy some updates away from its start and observations about its statistics; with
+    ``memory``, the policy remembers its task's loops (``MLPPolicy.integral``)."""
     flight = FlightSpec.solo("c172p", "altitude", episode_time_s=3.0)
-    n_obs = flight.make_env().observation_space.shape[0]
+    names = list(flight.make_env().task.observation_names)
+    config = MLPConfig(hidden=[32, 16])
+    if memory != "none":
+        config = MLPConfig(
+            hidden=[32, 16], memory=memory, memory_flight=flight.to_dict(), memory_observation=names
+        )
+    n_obs = len(names) + len(config.memory_names)
     torch.manual_seed(0)
     rng = np.random.default_rng(0)
     stats = [{"mean": rng.normal(size=n), "std": rng.uniform(0.5, 2, size=n)} for n in (n_obs, 4)]
-    module = MLPPolicy(MLPConfig(hidden=[32, 16]), *stats)
-    fn = partial(make_env, flight.to_dict(), [0.0] * 4, [0.3] * 4, 0.0)
+    module = MLPPolicy(config, *stats)
+    fn = partial(make_env, flight.to_dict(), [0.0] * 4, [0.3] * 4, 0.0, module.memory_maker())
     cfg = PPORunConfig(task="altitude", aircraft="c172p")
     model = make_model(cfg, DummyVecEnv([fn]), module, tmp_path, "cpu", flight.agent_hz)
     policy = model.policy
@@ -43,8 +51,9 @@ def _policy(tmp_path):
     return policy, obs
 
 
-def test_the_numpy_pass_samples_as_the_policy_does(tmp_path):
-    policy, obs = _policy(tmp_path)
+@pytest.mark.parametrize("memory", ["none", "vertical"])
+def test_the_numpy_pass_samples_as_the_policy_does(tmp_path, memory):
+    policy, obs = _policy(tmp_path, memory)
     sampler = NumpyActorCritic(sampling_copy(policy), np.random.default_rng(3))
     sampler.reset_noise(len(obs))
     action, value, log_prob = sampler(obs)
