@@ -24,7 +24,7 @@ def remembered(frames: Frames, policy: Any) -> Frames:
     asked = getattr(policy, "memory", "none")
     if asked == "none":
         return frames
-    from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe, kind_for, names_of
+    from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe, names_of
 
     if any(n in NAMES for n in frames.observation_names):
         return frames  # already remembered (DAgger's rounds hand the frames on)
@@ -36,9 +36,9 @@ def remembered(frames: Frames, policy: Any) -> Frames:
                 f"solo flight spec: {why or 'a team flight'}; train with --memory none"
             )
         recipe = LoopMemoryRecipe.for_flight(flight.to_dict(), frames.observation_names)
-        kind = kind_for(recipe.targets) if asked == "auto" else asked
+        kind = recipe.default if asked == "auto" else asked
         if kind == "none":
-            log.info("the policy remembers nothing: %s holds its start altitude", flight.task)
+            log.info("the policy remembers nothing: the %s task asks for no memory", flight.task)
             return frames
         memory = _columns(frames, recipe.new(kind))
     except ConfigError as err:

@@ -27,10 +27,10 @@ class MLPConfig(PolicyConfig):
             episode's start, so it can hold what a demonstrator integrates (trim, PID
             integrals). `vertical`: the climb-rate and pitch loops (what holds an
             altitude); `loops`: every loop (also roll, airspeed, slip); `none`: the
-            observation alone; `auto`: `vertical` where the task's expert follows a
-            vertical target the task observes (altitude, pitch, turn, climb-turn, waypoints,
-            formation, approach), `none` where it holds the start altitude (roll, heading,
-            airspeed, sideslip, level) or the dataset is not of one solo flight.
+            observation alone; `auto`: what the task asks for (`Task.memory`):
+            `vertical` for altitude, pitch, turn, climb-turn, waypoints and approach,
+            `none` for the tasks that hold their start altitude (roll, heading, airspeed,
+            sideslip, level) and formation, or where the dataset is not of one solo flight.
     """
 
     hidden: list[int] = field(default_factory=lambda: [256, 256])

@@ -34,16 +34,6 @@ def names_of(kind: str) -> tuple[str, ...]:
     return tuple(f"memory.{loop}_error_integral" for loop in LOOPS[kind])
 
 
-def kind_for(targets: Any) -> str:
-    """The memory a task's expert (its ``Targets``) calls for by default: `vertical` where its
-    vertical loop follows a target the task observes (an altitude, a glidepath, a slot, a
-    pitch), `none` where it only holds the start altitude (roll, heading, airspeed, ...):
-    there the still-air demonstrations barely move the vertical integrals, the clone's weights
-    on them are guesses, and in turbulence a heading clone with them crashed 3 of 16
-    (docs/results/memory.md)."""
-    return "vertical" if isinstance(targets.vertical_source, str) else "none"
-
-
 def kind_of(observation_names: Sequence[str]) -> str:
     """The kind of memory whose columns end ``observation_names`` ("none": no memory)."""
     held = tuple(n for n in observation_names if n in NAMES)
@@ -64,6 +54,7 @@ class LoopMemoryRecipe:
     targets: Any
     gains: Any
     throttle: float
+    default: str = "none"  # what the task remembers by default (``Task.memory``)
 
     @classmethod
     def for_flight(
@@ -85,9 +76,10 @@ class LoopMemoryRecipe:
                 )
             model, dt = env.aircraft.model, env.dt
             pilot = controller_for(env.task, model, dt, env.aircraft.profile.cruise_throttle)
+            default = env.task.memory()
         finally:
             env.close()
-        return cls(names, model, dt, pilot.targets, pilot.gains, pilot.throttle_trim)
+        return cls(names, model, dt, pilot.targets, pilot.gains, pilot.throttle_trim, default)
 
     def new(self, kind: str = "loops") -> LoopMemory:
         from gymfg_il.controllers.autopilot import Autopilot

@@ -76,7 +76,7 @@ class MLPPolicy(NormalizedPolicy):
         """What makes the fresh memory of an episode (a ``LoopMemory``), or None without
         memory: picklable, so an env in another process (PPO's, ``rl.envs.Remembering``)
         computes the memory with the code and the numbers this policy flies with."""
-        if self.config.memory == "none":
+        if not self.n_memory:
             return None
         return partial(self.recipe().new, self.config.memory)
 

@@ -237,6 +237,16 @@ class Task:
         ``controllers.autopilot.controller_for`` builds; None: the task has none."""
         return None
 
+    def memory(self) -> str:
+        """What a policy cloned for this task remembers by default (``train bc --memory
+        auto``; ``policies.memory``): `vertical` (its expert's climb-rate and pitch loop
+        integrals) where the expert's vertical loop follows a target the task observes,
+        `none` where it holds the start altitude (the demonstrations then barely move those
+        integrals, and a clone's weights on them are guesses: docs/results/memory.md)."""
+        expert = self.expert()
+        followed = expert is not None and isinstance(expert.targets.vertical_source, str)
+        return "vertical" if followed else "none"
+
     def describe(self) -> dict[str, Any]:
         """What the task is, for logs and dataset metadata."""
         return {

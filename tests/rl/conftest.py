@@ -7,13 +7,15 @@ import pytest
 
 @pytest.fixture(scope="session")
 def bc_policy(tiny_dataset, tmp_path_factory):
-    """An MLP cloned from the tiny altitude demonstrations (30-s episodes); tests read it,
-    never write it."""
+    """An MLP cloned from the tiny altitude demonstrations (30-s episodes) without memory
+    (``remembering_bc`` has one); tests read it, never write it."""
     from gymfg_il.learning.bc import train_bc
     from gymfg_il.learning.config import TrainConfig
+    from gymfg_il.policies.configuration_mlp import MLPConfig
 
     out = tmp_path_factory.mktemp("rl") / "bc"
-    train_bc(TrainConfig(dataset=tiny_dataset, out=out, epochs=3, seed=0))
+    policy = MLPConfig(memory="none")
+    train_bc(TrainConfig(dataset=tiny_dataset, out=out, epochs=3, seed=0, policy=policy))
     return out
 
 

@@ -161,6 +161,7 @@ def test_a_policy_without_memory_is_saved_as_before(bc_policy):
         "type": "ppo",
         "hidden": [256, 256],
         "dropout": 0.0,
+        "memory": "none",  # chosen by train bc (--memory auto chose none or was told so)
     }
     assert "memory_names" not in meta_of(start)
     env = make_env(start.flight.to_dict(), [0.0] * 4, [1.0] * 4)
