@@ -124,6 +124,7 @@ class FormationTask(ManeuverTask):
         the vertical loops' integrals held it 69 % of the time, one without 100 %
         (docs/results/memory.md)."""
         return "none"
+
     # the lead's heading and bank as bugs; the slot's offset (behind/ahead, right/left,
     # below/above) and the closure rate, in words and on a diagram
     guidance = (
