@@ -1,13 +1,15 @@
 """Ways for a cloned policy to remember, side by side on held-out seeds (docs/results/memory.md).
 
-Each case collects autopilot demonstrations (`collect autopilot`, DART noise as given), trains
+Each case collects autopilot demonstrations (`collect autopilot`, DART noise as given; the
+`pilot` case: 30 of the synthetic pilot on the keyboard, who trims, with the pilot's row
+beside the controller's), trains
 every variant on them with `train bc`'s defaults otherwise, and flies the controller and every
 policy on the same held-out seeds with `eval`. Printed per case and variant: success, return
 over the controller's, crashes, the mean steady-state error, and the copycat probe (R^2 of each
 action from the step's previous action alone, by least squares over every flown step; the
 controller's own beside it).
 
-    python docs/experiments/memory.py OUT [--cases 5-demos gusts] [--tasks altitude heading]
+    python docs/experiments/memory.py OUT [--cases 5-demos gusts pilot] [--tasks altitude heading]
         [--noise 0.05 0.2] [--variants mlp vertical loops chunk gru] [--episodes 16] [--seed 7000]
 
 Variants: `mlp` (no memory), `vertical` (`--memory vertical`: the climb-rate and pitch
@@ -32,6 +34,7 @@ CASES = {
     # name: (demonstrations, the air they are flown in, the air the policies are flown in)
     "5-demos": (5, "none", "none"),
     "gusts": (10, "none", "moderate"),
+    "pilot": (30, "none", "none"),  # the synthetic pilot on the keyboard, who trims
 }
 VARIANTS = {
     "mlp": ["--memory", "none"],
@@ -69,24 +72,37 @@ def case_rows(out: Path, case: str, task: str, noise: float, args: argparse.Name
     from gymfg_il.evaluation.runner import run_eval
 
     demos, collect_air, eval_air = CASES[case]
-    data = out / f"{case}-{task}-noise{noise:g}"
-    if not data.exists():
+    stem = data = out / f"{case}-{task}-noise{noise:g}"
+    if case == "pilot":
+        if not data.exists():
+            run("gymfg_il.collect", "manual", "--pilot", "synthetic", "--device", "keyboard",
+                "--task", task, "--episodes", str(demos), "--seed", "2000", "--out", str(data),
+                "--no-progress")  # fmt: skip
+        data = data / "dataset"
+    elif not data.exists():
         run("gymfg_il.collect", "autopilot", "--task", task, "--episodes", str(demos),
             "--seed", "100", "--noise", str(noise), "--turbulence", collect_air,
             "--out", str(data), "--no-progress")  # fmt: skip
     policies = []
     for variant in args.variants:
-        folder = data.with_name(data.name + f"-{variant}")
+        folder = stem.with_name(stem.name + f"-{variant}")
         if not folder.exists():
             run("gymfg_il.train", "bc", "--dataset", str(data), "--out", str(folder),
                 "--no-progress", *VARIANTS[variant])  # fmt: skip
         policies.append(folder)
+    pilot = "synthetic" if case == "pilot" else None
     cfg = EvalConfig(
-        policy=policies, episodes=args.episodes, seed=args.seed, workers=2, turbulence=eval_air
+        policy=policies,
+        episodes=args.episodes,
+        seed=args.seed,
+        workers=2,
+        turbulence=eval_air,
+        pilot=pilot,
     )
     result = run_eval(cfg)
     ctrl = result.rows[0]
-    for row, variant in zip(result.rows, ["controller", *args.variants], strict=True):
+    agents = ["controller", *(["pilot"] if pilot else []), *args.variants]
+    for row, variant in zip(result.rows, agents, strict=True):
         traces = result.traces[row["agent"]]
         ret = row["mean_return"] / ctrl["mean_return"]
         crashes = sum(t.terminated for t in traces)

@@ -1,5 +1,6 @@
-"""What one step of flight costs a policy: ``PolicyAgent.act`` for the default MLP and the
-default GRU (its hidden state carried: one GRU step per call, whatever the step), on one
+"""What one step of flight costs a policy: ``PolicyAgent.act`` for the MLP without memory,
+the MLP with the vertical loops' memory (``--memory vertical``, the altitude task's default;
+its loop integrals updated once per step) and the default GRU (its hidden state carried: one GRU step per call, whatever the step), on one
 episode of the bundled sample's observations, one torch thread, untrained weights (a step
 costs the same). Paired rounds in alternating order, so a busy machine slows both alike;
 prints the median step over all rounds, the range of the rounds' medians, the GRU's first
@@ -17,7 +18,9 @@ from pathlib import Path
 import torch
 
 from gymfg_il.learning.data import load_frames
+from gymfg_il.learning.memory import remembered
 from gymfg_il.policies.agent import PolicyAgent
+from gymfg_il.policies.configuration import DatasetInfo
 from gymfg_il.policies.configuration_gru import GRUConfig
 from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.policies.factory import make_policy
@@ -30,10 +33,18 @@ torch.set_num_threads(1)
 frames = load_frames(SAMPLE)
 episode = frames.obs[frames.episode == frames.episode[0]][:STEPS]
 meta = {"observation_names": frames.observation_names}
-agents = {
-    name: PolicyAgent(make_policy(config, frames.obs_stats, frames.action_stats).eval(), meta)
-    for name, config in (("mlp", MLPConfig()), ("gru", GRUConfig()))
+CONFIGS = {
+    "mlp": MLPConfig(memory="none"),
+    "mlp+memory": MLPConfig(memory="vertical"),
+    "gru": GRUConfig(),
 }
+agents = {}
+for name, config in CONFIGS.items():
+    extended = remembered(frames, config)  # the memory's columns and statistics, if any
+    info = DatasetInfo(extended.observation_names, frames.fps, frames.flight()[0])
+    completed = config.for_data(info)
+    module = make_policy(completed, extended.obs_stats, frames.action_stats).eval()
+    agents[name] = PolicyAgent(module, meta)
 
 
 def one_episode(agent: PolicyAgent) -> list[float]:
@@ -57,10 +68,10 @@ for r in range(ROUNDS):
         steps[name] += times
         medians[name].append(statistics.median(times))
 print(f"{ROUNDS} rounds of {len(episode)} steps, torch {torch.__version__}, 1 thread")
-for name, config in (("mlp", MLPConfig()), ("gru", GRUConfig())):
+for name, config in CONFIGS.items():
     low, high = min(medians[name]) * 1e6, max(medians[name]) * 1e6
     print(
-        f"{name} {config}: median step {statistics.median(steps[name]) * 1e6:.1f} us "
+        f"{name}: median step {statistics.median(steps[name]) * 1e6:.1f} us "
         f"(rounds {low:.1f}-{high:.1f} us)"
     )
 n = len(episode)
@@ -70,5 +81,7 @@ print(
     f"gru, first and last 100 steps of the episodes: {statistics.median(early) * 1e6:.1f} "
     f"and {statistics.median(late) * 1e6:.1f} us (the same work at every step)"
 )
-ratios = [g / m for g, m in zip(medians["gru"], medians["mlp"], strict=True)]
-print(f"gru / mlp: {statistics.median(ratios):.2f} (rounds {min(ratios):.2f}-{max(ratios):.2f})")
+for name in ("mlp+memory", "gru"):
+    ratios = [g / m for g, m in zip(medians[name], medians["mlp"], strict=True)]
+    low, high = min(ratios), max(ratios)
+    print(f"{name} / mlp: {statistics.median(ratios):.2f} (rounds {low:.2f}-{high:.2f})")
