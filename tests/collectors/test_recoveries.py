@@ -59,6 +59,7 @@ def card(out):
     return (out / "dataset" / "README.md").read_text()
 
 
+@pytest.mark.slow  # its sessions take ~30 s
 def test_noise_perturbs_what_the_synthetic_pilot_flies_not_what_the_dataset_records(sessions):
     out, pilot, log, frames = sessions["both"]
     steps = log.complete_episodes[0].steps["ego"]
@@ -73,6 +74,7 @@ def test_noise_perturbs_what_the_synthetic_pilot_flies_not_what_the_dataset_reco
     assert np.array_equal(still.action, still.label) and sessions["still"][2].session["noise"] == 0
 
 
+@pytest.mark.slow  # its sessions take ~30 s
 def test_gusts_knock_the_aircraft_about_and_the_dataset_keeps_the_pilots_answers(sessions):
     out, pilot, log, frames = sessions["gusty"]
     assert np.allclose(frames.action, pilots_own(pilot, frames.action[0]), atol=1e-6)
@@ -111,6 +113,7 @@ def dataset_bits(out):
     return frames, records
 
 
+@pytest.mark.slow  # its sessions take ~30 s
 def test_a_seed_reproduces_the_noise_and_the_gusts_bit_for_bit(sessions):
     out, _, log, frames = sessions["both"]
     again_out, _, again_log, again = sessions["both again"]

@@ -129,6 +129,7 @@ def test_recover_rebuilds_every_episode_of_a_dagger_session_and_names_what_it_ca
     assert summary(session / "dataset")[0] == 2  # the DAgger episodes alone
 
 
+@pytest.mark.slow  # a DAgger run
 def test_dagger_flies_a_recurrent_policy_with_its_state_carried_and_reset(
     tiny_gru, tmp_path, carried_state
 ):

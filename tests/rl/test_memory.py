@@ -100,6 +100,7 @@ def _flies_with_its_memory(path, flight, seed=11):
     assert gaps[1] > 1e-3
 
 
+@pytest.mark.slow  # PPO runs
 def test_a_fine_tune_of_a_remembering_policy_keeps_its_memory_and_repeats(remembering_bc, tmp_path):
     from safetensors.torch import load_file
 
@@ -134,6 +135,7 @@ def test_a_fine_tune_of_a_remembering_policy_keeps_its_memory_and_repeats(rememb
     assert (again.policy.type, again.policy.memory) == ("mlp", "vertical")
 
 
+@pytest.mark.slow  # PPO runs
 def test_stable_baselines3s_own_sampler_fine_tunes_a_remembering_policy(remembering_bc, tmp_path):
     from safetensors.torch import load_file
 
