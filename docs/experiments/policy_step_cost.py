@@ -1,11 +1,12 @@
 """What one step of flight costs a policy: ``PolicyAgent.act`` for the MLP without memory,
 the MLP with the vertical loops' memory (``--memory vertical``, the altitude task's default;
-its loop integrals updated once per step) and the default GRU (its hidden state carried: one GRU step per call, whatever the step), on one
-episode of the bundled sample's observations, one torch thread, untrained weights (a step
-costs the same). Paired rounds in alternating order, so a busy machine slows both alike;
-prints the median step over all rounds, the range of the rounds' medians, the GRU's first
-and last 100 steps of the episodes, and the median of the rounds' GRU / MLP ratios. Not a
-feature: a measurement behind docs/results/defaults.md ("Why a GRU epoch is slow").
+its loop integrals updated once per step) and the default GRU (its hidden state carried: one
+GRU step per call, whatever the step), on one episode of the bundled sample's observations,
+one torch thread, untrained weights (a step costs the same). Paired rounds in alternating
+order, so a busy machine slows all alike; prints the median step over all rounds, the range
+of the rounds' medians, the GRU's first and last 100 steps of the episodes, and the median
+of the rounds' ratios to the MLP. Not a feature: a measurement behind docs/results/memory.md
+and docs/results/defaults.md ("Why a GRU epoch is slow").
 
     python docs/experiments/policy_step_cost.py [ROUNDS] [STEPS]
 """
@@ -68,7 +69,7 @@ for r in range(ROUNDS):
         steps[name] += times
         medians[name].append(statistics.median(times))
 print(f"{ROUNDS} rounds of {len(episode)} steps, torch {torch.__version__}, 1 thread")
-for name, config in CONFIGS.items():
+for name in CONFIGS:
     low, high = min(medians[name]) * 1e6, max(medians[name]) * 1e6
     print(
         f"{name}: median step {statistics.median(steps[name]) * 1e6:.1f} us "

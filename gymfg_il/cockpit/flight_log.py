@@ -86,7 +86,7 @@ class FlightLog:
         self.steps = self.interventions = 0
         self.timing = EpisodeTiming(self.dt)
         gusts = self.sim.gusts if self.sim is not None else ()
-        blown = {"gusts": gust_records(gusts)} if gusts else {}
+        blown: dict[str, Any] = {"gusts": gust_records(gusts)} if gusts else {}
         self._writer().start_episode(
             seed, starts, source=self.source, pilot=self.pilot_name, **blown
         )

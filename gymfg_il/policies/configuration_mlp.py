@@ -67,7 +67,7 @@ class MLPConfig(PolicyConfig):
         columns), the flight its loops are taken from and the observation they read."""
         from gymfg_il.policies.memory import NAMES, kind_of
 
-        kind = kind_of(data.observation_names)
+        kind: Any = kind_of(data.observation_names)  # one of LOOPS' names
         if self.memory not in ("auto", kind):
             raise ConfigError(
                 f"--memory {self.memory}: the frames hold the memory {kind!r}; train on "
