@@ -166,15 +166,26 @@ class Autopilot:
         return float(source)
 
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
-        # Python floats: the same double arithmetic as numpy scalars, at a fraction of the cost
-        obs: list[float] = np.asarray(observation, dtype=np.float64).tolist()
-        if self.start is None:
-            self.start = list(obs)
-            self.speed_pid.bias = self.throttle_trim
+        obs = self._taken(observation)
         nose_up = self._vertical(obs)
         aileron = self._lateral(obs)
         throttle = self._speed(obs)
         return np.array([aileron, -nose_up, self._rudder(obs), throttle])
+
+    def follow_vertical(self, observation: np.ndarray) -> None:
+        """Run the vertical loops alone on ``observation``, as ``act`` runs them (their
+        integrals are a policy's memory, ``policies.memory``; the other loops do not feed
+        them)."""
+        self._vertical(self._taken(observation))
+
+    def _taken(self, observation: np.ndarray) -> list[float]:
+        """The observation as Python floats (the same double arithmetic as numpy scalars, at
+        a fraction of the cost); the first of an episode is its start."""
+        obs: list[float] = np.asarray(observation, dtype=np.float64).tolist()
+        if self.start is None:
+            self.start = list(obs)
+            self.speed_pid.bias = self.throttle_trim
+        return obs
 
     def _vertical(self, obs: list[float]) -> float:
         """Altitude -> climb rate -> pitch -> elevator, as the nose-up command (positive

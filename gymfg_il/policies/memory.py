@@ -96,6 +96,7 @@ class LoopMemory:
         self.pilot = pilot
         self.pids = tuple(getattr(pilot, f"{loop}_pid") for loop in loops)
         self.names = tuple(f"memory.{loop}_error_integral" for loop in loops)
+        self.vertical_only = set(loops) <= {"climb", "pitch"}
 
     def reset(self) -> None:
         self.pilot.reset()
@@ -111,7 +112,11 @@ class LoopMemory:
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         """The integrals once ``observation`` (float32, the policy's) is taken in."""
-        self.pilot.act(np.asarray(observation, dtype=np.float32))
+        taken = np.asarray(observation, dtype=np.float32)
+        if self.vertical_only:  # the other loops do not feed these: half the work
+            self.pilot.follow_vertical(taken)
+        else:
+            self.pilot.act(taken)
         return np.array([pid.integral for pid in self.pids], dtype=np.float32)
 
     def over(self, obs: np.ndarray) -> np.ndarray:

@@ -124,3 +124,14 @@ def test_auto_remembers_the_vertical_loops_and_says_which(tiny_dataset):
         "dropout": 0.0,
         "memory": "none",
     }
+
+
+def test_the_vertical_loops_alone_integrate_as_the_whole_autopilot_does(tiny_dataset):
+    frames = load_frames(tiny_dataset)
+    spec, _ = frames.flight()
+    recipe = LoopMemoryRecipe.for_flight(spec.to_dict(), frames.observation_names)
+    obs = frames.obs[frames.episode == frames.episode[0]]
+    whole = recipe.new("loops").over(obs)[:, :2]  # climb and pitch, every loop run
+    alone = recipe.new("vertical")
+    assert alone.vertical_only and not recipe.new("loops").vertical_only
+    assert np.array_equal(alone.over(obs), whole)
