@@ -11,6 +11,7 @@ controller's own beside it).
 
     python docs/experiments/memory.py OUT [--cases 5-demos gusts pilot] [--tasks altitude heading]
         [--noise 0.05 0.2] [--variants mlp vertical loops chunk gru] [--episodes 16] [--seed 7000]
+        [--demo-seed 100]
 
 Variants: `mlp` (no memory), `vertical` (`--memory vertical`: the climb-rate and pitch
 loops), `loops` (`--memory loops`: every loop), `chunk` (an observation window of 8
@@ -81,7 +82,7 @@ def case_rows(out: Path, case: str, task: str, noise: float, args: argparse.Name
         data = data / "dataset"
     elif not data.exists():
         run("gymfg_il.collect", "autopilot", "--task", task, "--episodes", str(demos),
-            "--seed", "100", "--noise", str(noise), "--turbulence", collect_air,
+            "--seed", str(args.demo_seed), "--noise", str(noise), "--turbulence", collect_air,
             "--out", str(data), "--no-progress")  # fmt: skip
     policies = []
     for variant in args.variants:
@@ -122,6 +123,7 @@ def main() -> None:
     parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
     parser.add_argument("--episodes", type=int, default=16)
     parser.add_argument("--seed", type=int, default=7000, help="first held-out seed")
+    parser.add_argument("--demo-seed", type=int, default=100, help="first demonstration's seed")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     print("| case | task | noise | agent | success | return | crashes | ss error | copycat |")
