@@ -26,12 +26,19 @@ LOOPS = {
     "vertical": ("climb", "pitch"),  # what holds an altitude: climb rate, then pitch
     "loops": ("climb", "pitch", "roll", "speed", "slip"),
 }
-NAMES = tuple(f"memory.{loop}_error_integral" for loop in LOOPS["loops"])
+
+
+def feature_names(loops: Sequence[str]) -> tuple[str, ...]:
+    """The memory's feature names for ``loops``, in their order."""
+    return tuple(f"memory.{loop}_error_integral" for loop in loops)
+
+
+NAMES = feature_names(LOOPS["loops"])
 
 
 def names_of(kind: str) -> tuple[str, ...]:
     """The feature names of a kind of memory (``LOOPS``)."""
-    return tuple(f"memory.{loop}_error_integral" for loop in LOOPS[kind])
+    return feature_names(LOOPS[kind])
 
 
 def kind_of(observation_names: Sequence[str]) -> str:
@@ -95,7 +102,7 @@ class LoopMemory:
     def __init__(self, pilot: Any, loops: Sequence[str] = LOOPS["loops"]) -> None:
         self.pilot = pilot
         self.pids = tuple(getattr(pilot, f"{loop}_pid") for loop in loops)
-        self.names = tuple(f"memory.{loop}_error_integral" for loop in loops)
+        self.names = feature_names(loops)
         self.vertical_only = set(loops) <= {"climb", "pitch"}
 
     def reset(self) -> None:
