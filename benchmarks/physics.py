@@ -35,7 +35,7 @@ def env_vs_raw(steps: int, rounds: int) -> Row:
         "env_step_vs_raw_jsbsim",
         r["ratio"],
         "ratio",
-        0.90,
+        0.95,
         detail=[
             f"env.step (c172p, 10 Hz)     {r['candidate']:9,.0f} steps/s (median)",
             f"raw FGFDMExec, same I/O     {r['reference']:9,.0f} steps/s (median)",

@@ -17,15 +17,6 @@ from gymfg_il.sim.properties import ACTION_NAMES
 Controls = tuple[float, float, float, float]
 
 
-def _clip(a0: float, a1: float, a2: float, a3: float) -> Controls:
-    return (
-        -1.0 if a0 < -1.0 else 1.0 if a0 > 1.0 else a0,
-        -1.0 if a1 < -1.0 else 1.0 if a1 > 1.0 else a1,
-        -1.0 if a2 < -1.0 else 1.0 if a2 > 1.0 else a2,
-        0.0 if a3 < 0.0 else 1.0 if a3 > 1.0 else a3,
-    )
-
-
 def _bad_values(values: Sequence[float], names: Sequence[str]) -> list[str]:
     return [f"{n}={v!r}" for n, v in zip(names, values, strict=True) if not np.isfinite(v)]
 
@@ -49,7 +40,12 @@ def controls(action: object, who: str = "action") -> Controls:
             f"{who} has non-finite values ({', '.join(bad)}); nothing was sent to JSBSim. "
             "Check the agent's output (e.g. a policy fed unnormalised observations)"
         )
-    return _clip(a0, a1, a2, a3)
+    return (  # clipped, written out: this runs at every step of every aircraft
+        -1.0 if a0 < -1.0 else 1.0 if a0 > 1.0 else a0,
+        -1.0 if a1 < -1.0 else 1.0 if a1 > 1.0 else a1,
+        -1.0 if a2 < -1.0 else 1.0 if a2 > 1.0 else a2,
+        0.0 if a3 < 0.0 else 1.0 if a3 > 1.0 else a3,
+    )
 
 
 def clip(action: object, who: str = "action") -> np.ndarray:

@@ -93,6 +93,8 @@ class World:
                 "FlightGear's clock",
                 config.agent_hz,
             )
+        # anything outside to tell of each step (views, traffic, a multiplayer link)?
+        self._outward = bool(self.displays) or self.link is not None
         self.steps = 0
         self.started = False
 
@@ -217,10 +219,11 @@ class World:
             slot.prev_action = slot.action
             slot.action = np.array(act)
         self.steps += 1
-        if self.displays:
-            self.displays.show()
-        if self.link is not None:
-            self._exchange()
+        if self._outward:
+            if self.displays:
+                self.displays.show()
+            if self.link is not None:
+                self._exchange()
 
     def _exchange(self) -> None:
         """Send our aircraft to FlightGear, hear FlightGear's, and keep to its clock (real

@@ -64,8 +64,9 @@ def gaussian(error: float, scale: float) -> float:
 
 def action_change(prev_action: np.ndarray, action: np.ndarray) -> float:
     """Mean absolute change of the three surfaces between two steps (0 = perfectly smooth)."""
-    return (
-        abs(action[0] - prev_action[0])
-        + abs(action[1] - prev_action[1])
-        + abs(action[2] - prev_action[2])
-    ) / 3.0
+    if type(action) is np.ndarray and type(prev_action) is np.ndarray:
+        # as Python floats: the same doubles at a third of numpy scalars' cost
+        a, b = action.tolist(), prev_action.tolist()
+    else:
+        a, b = action, prev_action
+    return (abs(a[0] - b[0]) + abs(a[1] - b[1]) + abs(a[2] - b[2])) / 3.0

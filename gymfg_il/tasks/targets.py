@@ -147,7 +147,11 @@ class TargetTask(Task):
         self.fixed_target = target
         self.hold_s = float(hold_s)
         self._var = INDEX[fam.variable]
+        self._angular = fam.angular
+        # the observed variables' indices and three placeholders for the target's entries
+        self._obs_idx_extended = np.r_[self._obs_idx, [0, 0, 0]]
         self._targets: np.ndarray = np.zeros(1)
+        self._target_list: list[float] = [0.0]  # the same, as Python floats (read each step)
         self.start_value = 0.0
         self._integral = 0.0
         self._integral_step = -1
@@ -187,6 +191,7 @@ class TargetTask(Task):
         n = self.max_steps + 1
         if not self.dynamic:
             self._targets = np.full(n, self._absolute(first))
+            self._target_list = self._targets.tolist()
             return
         # A rate-limited walk from the start value through seeded waypoints (the first one is
         # ``target`` when given), in the family's offset convention.
@@ -203,10 +208,11 @@ class TargetTask(Task):
         if self.family.relative:
             offsets += self.start_value
         self._targets = wrap_360(offsets) if self.family.angular else offsets
+        self._target_list = self._targets.tolist()
 
     def target_value(self, step: int) -> float:
-        targets = self._targets
-        return float(targets[step if step < len(targets) else -1])
+        targets = self._target_list
+        return targets[step] if step < len(targets) else targets[-1]
 
     def error(self, value: float, step: int) -> float:
         """Target minus value at ``step`` (wrapped to [-180, 180) for angles)."""
@@ -217,11 +223,11 @@ class TargetTask(Task):
 
     def observe(self, state: np.ndarray, step: int) -> np.ndarray:
         n = self._n_vars
-        obs = np.empty(n + 3, np.float32)
-        obs[:n] = state[self._obs_idx]
-        target = self.target_value(step)
-        err = target - state[self._var]
-        if self.family.angular:
+        obs = state[self._obs_idx_extended].astype(np.float32)  # its last three written below
+        targets = self._target_list
+        target = targets[step] if step < len(targets) else targets[-1]
+        err = target - state.item(self._var)  # Python floats: the same doubles, less overhead
+        if self._angular:
             err = wrap_180(err)
         if step > self._integral_step:  # once per step, however often it is observed
             missed = step - self._integral_step if self._integral_step >= 0 else 1
@@ -236,8 +242,8 @@ class TargetTask(Task):
     def task_reward(self, ctx: RewardContext) -> float:
         """closeness(error, reward_scale) - 0.05 * mean |change of the three surfaces|."""
         target = ctx.target if ctx.target is not None else self.target_value(ctx.step)
-        err = target - ctx.state.values[self._var]
-        if self.family.angular:
+        err = target - ctx.state.values.item(self._var)
+        if self._angular:
             err = wrap_180(err)
         smooth = action_change(ctx.prev_action, ctx.action)
         return math.exp(-abs(err) / self.reward_scale) - SMOOTHNESS_WEIGHT * smooth
