@@ -91,8 +91,11 @@ def synthetic_pilot(seconds: float) -> Row:
         "x",
         300.0,
         detail=[
-            f"synthetic pilot: {stats.frames} frames at 30 Hz in {wall:.1f} s (the dataset "
-            f"built at the end included); the env alone, the same flights: {ceiling:.0f}x"
+            f"synthetic pilot: {stats.frames} frames at 30 Hz in {wall:.1f} s, of which the "
+            f"session's end {stats.closing_s:.1f} s (the dataset built, LeRobot's imports "
+            f"waited for); the loop alone {2 * seconds / (wall - stats.closing_s):.0f}x, "
+            f"the env alone on the same flights {ceiling:.0f}x "
+            "(where a frame goes: docs/experiments/synthetic_profile.py)"
         ],
     )
 

@@ -27,13 +27,15 @@ EPISODE_COMMANDS = ("end", "discard", "pause")  # what a flown (recording or pau
 @dataclass
 class SessionStats:
     """What a session did: episodes saved and discarded, frames run, each loop period (s),
-    and the dataset once it is built."""
+    the dataset once it is built, and the seconds its end took (``closing_s``: the dataset
+    catching up with the log, the helper's imports included when it had not finished them)."""
 
     saved: int = 0
     discarded: int = 0
     frames: int = 0
     periods: list[float] = field(default_factory=list)
     dataset: Path | None = None
+    closing_s: float = 0.0
 
 
 class Phases:

@@ -26,6 +26,7 @@ uses; ``cockpit.build`` makes them from the config. Each frame:
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 
 from gymfg_il.cockpit.build import Stages, build
@@ -165,6 +166,7 @@ class ManualSession:
         """Close the log, the env, the input and the window; the dataset catches up with the
         log (``stats.dataset`` says where it is once built)."""
         s = self.stages
+        started = time.perf_counter()
         s.log.close()
         s.env.close()
         s.input.close()
@@ -173,3 +175,4 @@ class ManualSession:
             s.updater.request()
         if s.updater.close():
             s.stats.dataset = s.out / DATASET
+        s.stats.closing_s = time.perf_counter() - started

@@ -57,6 +57,7 @@ def test_keyboard_rates_and_centring_reach_the_dataset(tmp_path):
     }
     stats = run(tmp_path, script)
     assert stats.saved == 1
+    assert stats.closing_s > 0  # the session's end is timed (benchmarks.manual reports it)
     frames = load_frames(tmp_path / "dataset")
     aileron, throttle = frames.action[:, 0], frames.action[:, 3]
     assert len(aileron) == 90
