@@ -43,3 +43,7 @@ def test_the_rl_benchmark_prints_the_sampling_beside_its_ceiling():
     alone = ratios["rl_envs_alone_vs_physics_bound"]
     # the same envs with no policy to run are the ceiling of any sampler
     assert 0 < sampling < alone, done.stdout
+    # and the sampling over that ceiling has its own row, named for its env count (2 is not
+    # train ppo's default of four a core; here cores = 2)
+    assert 0 < ratios["rl_sampling_vs_envs_alone_2_envs"] < 1, done.stdout
+    assert "ppo_1m_steps_wall_min" not in done.stdout  # only where no env count is asked for

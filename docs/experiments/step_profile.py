@@ -129,6 +129,40 @@ def layers(
     ]
 
 
+def _raw_rate(steps: int, queue: Any) -> None:
+    """Steps/s of the bare loop (``benchmarks.physics.raw_loop``), put on ``queue``."""
+    from benchmarks.physics import raw_loop
+
+    run = raw_loop()
+    run(steps // 10)  # warm
+    t0 = time.perf_counter()
+    run(steps)
+    queue.put(steps / (time.perf_counter() - t0))
+
+
+def core_scaling(steps: int, rounds: int) -> tuple[float, int]:
+    """(the bare loop's steps/s in ``cores`` processes at once over one process's, cores):
+    what the physics bound of the RL rows (cores x one bare loop) assumes is ``cores``."""
+    import multiprocessing as mp
+    import os
+
+    cores = len(os.sched_getaffinity(0))
+    ctx = mp.get_context("forkserver")
+
+    def together(n: int) -> float:
+        queue = ctx.Queue()
+        procs = [ctx.Process(target=_raw_rate, args=(steps, queue)) for _ in range(n)]
+        for proc in procs:
+            proc.start()
+        total = sum(queue.get() for _ in procs)
+        for proc in procs:
+            proc.join()
+        return total
+
+    ratios = [together(cores) / together(1) for _ in range(rounds)]
+    return statistics.median(ratios), cores
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     p.add_argument("--calls", type=int, default=20000, help="calls a round")
@@ -149,6 +183,12 @@ def main(argv: list[str] | None = None) -> int:
         f"\nbare loop (physics + I/O) {physics + io:.1f} µs, env.step {step:.1f} µs: "
         f"the bound env_step_vs_raw_jsbsim can reach is {(physics + io) / step:.3f}"
     )
+    scaling, cores = core_scaling(3000, args.rounds)
+    print(
+        f"{cores} bare loops at once, each in a process of its own: {scaling:.2f}x one loop's "
+        f"steps/s (the RL rows' physics bound counts {cores}x)"
+    )
+    parts["bare loops on every core over one"] = scaling
     if args.json:
         args.json.write_text(json.dumps(parts, indent=2))
     return 0

@@ -60,11 +60,29 @@ def test_the_actor_starts_as_the_cloned_policy(bc_policy, tmp_path):
             mean = model.policy.get_distribution(batch).distribution.mean
             assert torch.equal(mean, bc.policy(batch))  # bit for bit, normalised
             normalised, _ = model.policy.predict(obs, deterministic=True)
-            raw = venv.envs[0].env.action(normalised)  # Monitor(TransformAction(env))
+            raw = venv.envs[0].env.action(normalised)  # Monitor(NormalizedActions(env))
             np.testing.assert_allclose(raw, np.clip(bc.act(obs), *_bounds(env)), atol=1e-5)
         env.close()
     finally:
         venv.close()
+
+
+def test_normalised_actions_are_numpys_arithmetic_bit_for_bit():
+    from gymfg_il.envs.flight import FlightSpec
+    from gymfg_il.rl.envs import normalized_actions
+
+    mean = np.array([0.01, -0.05, 0.002, 0.7])
+    std = np.array([0.1, 0.2, 1e-9, 0.1])  # a constant control: its spread counts as 1
+    env = normalized_actions(FlightSpec.solo("c172p", "altitude").make_env(), mean, std)
+    held = np.where(std < 1e-6, 1.0, std)
+    rng = np.random.default_rng(0)
+    for action in rng.normal(size=(2000, 4)).astype(np.float32):
+        # the fast path (four Python floats) gives numpy's doubles exactly
+        assert env.action(action).tobytes() == (action.astype(np.float64) * held + mean).tobytes()
+    batch = rng.normal(size=(3, 4)).astype(np.float32)  # anything else: numpy's own way
+    np.testing.assert_array_equal(env.action(batch), batch * held + mean)
+    assert env.action([0.0, 0.0, 0.0, 0.0]).tolist() == mean.tolist()
+    env.close()
 
 
 def _bounds(env):
