@@ -53,18 +53,17 @@ class PolicyAgent:
         self._state = None
 
     def act(self, observation: np.ndarray, opponent_states: np.ndarray | None = None) -> np.ndarray:
+        if self.camera is None:  # the raw action: the rollout loop (or the env) clips it
+            action, self._state = self.policy.step(observation, self._state)
+            return action
+        if self.see is None:
+            raise ConfigError(
+                f"{self.name} flies by its camera ({self.camera['view']}): fly it in a "
+                "GymFG env (eval, collect dagger), which gives it the camera's frames"
+            )
         torch = self._torch
         obs = torch.as_tensor(np.asarray(observation, dtype=np.float32), device=self.device)
-        inputs: Any = obs.unsqueeze(0)
-        if self.camera is not None:
-            if self.see is None:
-                raise ConfigError(
-                    f"{self.name} flies by its camera ({self.camera['view']}): fly it in a "
-                    "GymFG env (eval, collect dagger), which gives it the camera's frames"
-                )
-            frame = torch.as_tensor(self.see(), device=self.device)
-            inputs = (frame.unsqueeze(0), inputs)
-        action, self._state = self.policy.act(inputs, self._state)
-        # the raw action: the rollout loop (or the env) clips it to the contract
+        frame = torch.as_tensor(self.see(), device=self.device)
+        action, self._state = self.policy.act((frame.unsqueeze(0), obs.unsqueeze(0)), self._state)
         out: np.ndarray = action[0].double().cpu().numpy()
         return out

@@ -3,6 +3,8 @@ inside the checkpoint."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import torch
 from torch import nn
@@ -43,6 +45,19 @@ class NormalizedPolicy(nn.Module):
         self.action_norm = Normalizer(action_stats["mean"], action_stats["std"])
         self.n_obs, self.n_act = len(obs_stats["mean"]), len(action_stats["mean"])
         self.obs_noise = 0.0  # training only: std of noise on the normalised observation
+
+    def act(self, inputs: Any, state: Any = None) -> tuple[torch.Tensor, Any]:
+        """The raw actions for a batch of inputs, and the state carried on (each subclass's)."""
+        raise NotImplementedError
+
+    def step(self, observation: np.ndarray, state: Any = None) -> tuple[np.ndarray, Any]:
+        """One step of flight from one raw observation (``act`` on a batch of one): the raw
+        action (float64) and the state carried to the next step (``policies.agent``)."""
+        device = self.obs_norm.mean.device
+        obs = torch.as_tensor(np.asarray(observation, dtype=np.float32), device=device)
+        action, state = self.act(obs.unsqueeze(0), state)
+        out: np.ndarray = action[0].double().cpu().numpy()
+        return out, state
 
     def normalized(self, obs: torch.Tensor) -> torch.Tensor:
         """The normalised observation; while training, with ``obs_noise`` added (the policy

@@ -4,10 +4,17 @@ step to step, the same state at every step (O(1) work), and starts every episode
 from pathlib import Path
 
 import numpy as np
+import pytest
+import torch
 
 from gymfg_il.envs.actions import clip
 from gymfg_il.learning.data import load_frames
+from gymfg_il.learning.memory import remembered
 from gymfg_il.policies.agent import PolicyAgent
+from gymfg_il.policies.configuration import DatasetInfo
+from gymfg_il.policies.configuration_mlp import MLPConfig
+from gymfg_il.policies.factory import make_policy
+from gymfg_il.policies.normalize import NormalizedPolicy
 
 SAMPLE = Path(__file__).resolve().parents[2] / "datasets/sample-altitude-c172p/dataset"
 
@@ -43,3 +50,26 @@ def test_reset_starts_the_next_episode_as_a_fresh_agent_would(tiny_gru):
     fresh = fly(PolicyAgent.load(tiny_gru), second)
     assert np.array_equal(again, fresh)  # bit for bit: the same computation
     assert np.abs(unreset[0] - fresh[0]).max() > 1e-3  # the memory of the first episode
+
+
+@pytest.mark.parametrize("memory", ["none", "vertical"])
+def test_an_mlps_step_in_numpy_is_torchs_act_bit_for_bit(memory):
+    frames = load_frames(SAMPLE)
+    config = MLPConfig(memory=memory)
+    extended = remembered(frames, config)
+    info = DatasetInfo(extended.observation_names, frames.fps, frames.flight()[0])
+    torch.manual_seed(0)
+    module = make_policy(config.for_data(info), extended.obs_stats, frames.action_stats).eval()
+    (episode,) = sample_episodes(1)
+    fast = generic = None
+    for obs in episode[:300]:
+        a, fast = module.step(obs, fast)  # the elementwise arithmetic in numpy
+        b, generic = NormalizedPolicy.step(module, obs, generic)  # act on a batch of one
+        assert a.dtype == b.dtype == np.float64 and a.tobytes() == b.tobytes()
+    if memory != "none":  # the memory carried alike: one LoopMemory, the same integrals
+        assert fast[0].pids[0].integral == generic[0].pids[0].integral != 0.0
+    module.train()  # training (observation noise): torch's own path, the noise drawn there
+    module.obs_noise = 1.0
+    torch.manual_seed(1)
+    noisy, _ = module.step(episode[0])
+    assert np.abs(noisy - module.step(episode[0])[0]).max() > 0
