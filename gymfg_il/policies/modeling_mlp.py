@@ -12,7 +12,7 @@ import torch
 from torch import nn
 
 from gymfg_il.policies.configuration_mlp import MLPConfig
-from gymfg_il.policies.normalize import NormalizedPolicy
+from gymfg_il.policies.normalize import NormalizedPolicy, one_thread
 
 
 class MLPPolicy(NormalizedPolicy):
@@ -64,10 +64,11 @@ class MLPPolicy(NormalizedPolicy):
 
     def step(self, observation: np.ndarray, state: Any = None) -> tuple[np.ndarray, Any]:
         """``NormalizedPolicy.step`` with the elementwise arithmetic (normalising, the memory,
-        the action's scale) in numpy and only the layers in torch, on the CPU in eval mode:
+        the action's scale) in numpy and only the layers in torch (on one thread,
+        ``one_thread``), on the CPU in eval mode:
         float32 operations rounded as torch's are, so the same action bit for bit, at about
         two thirds of the cost of a step (eval, PPO's evaluations and DAgger fly it at every
-        step: tests/policies/test_mlp.py)."""
+        step: tests/policies/test_agent.py)."""
         obs_mean = self.obs_norm.mean
         if self.training or obs_mean.device.type != "cpu":
             return super().step(observation, state)
@@ -80,7 +81,7 @@ class MLPPolicy(NormalizedPolicy):
                 state = [fresh()]
             obs = np.concatenate([obs, state[0](obs)])
         x = torch.from_numpy((obs - obs_mean.numpy()) / self.obs_norm.std.numpy())[None]
-        with torch.no_grad():
+        with torch.no_grad(), one_thread():
             y = (
                 self.net(x)
                 if self.integral is None

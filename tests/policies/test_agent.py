@@ -73,3 +73,21 @@ def test_an_mlps_step_in_numpy_is_torchs_act_bit_for_bit(memory):
     torch.manual_seed(1)
     noisy, _ = module.step(episode[0])
     assert np.abs(noisy - module.step(episode[0])[0]).max() > 0
+
+
+def test_a_step_runs_its_layers_on_one_torch_thread_and_leaves_the_setting(monkeypatch):
+    frames = load_frames(SAMPLE)
+    config = MLPConfig(memory="none")
+    info = DatasetInfo(frames.observation_names, frames.fps, frames.flight()[0])
+    module = make_policy(config.for_data(info), frames.obs_stats, frames.action_stats).eval()
+    seen = []
+    module.net.register_forward_hook(lambda *_: seen.append(torch.get_num_threads()))
+    (episode,) = sample_episodes(1)
+    threads = torch.get_num_threads()
+    torch.set_num_threads(2)  # as a user's process may have it
+    try:
+        module.step(episode[0])  # the MLP's own step
+        NormalizedPolicy.step(module, episode[0])  # every other policy's
+        assert seen == [1, 1] and torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(threads)
