@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.errors import ConfigError
-from gymfg_il.policies.normalize import one_thread
+from gymfg_il.policies.normalize import OneThread
 
 
 class PolicyAgent:
@@ -65,7 +65,7 @@ class PolicyAgent:
         torch = self._torch
         obs = torch.as_tensor(np.asarray(observation, dtype=np.float32), device=self.device)
         frame = torch.as_tensor(self.see(), device=self.device)
-        with one_thread():
+        with OneThread():
             inputs = (frame.unsqueeze(0), obs.unsqueeze(0))
             action, self._state = self.policy.act(inputs, self._state)
         out: np.ndarray = action[0].double().cpu().numpy()

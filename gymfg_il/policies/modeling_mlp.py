@@ -12,7 +12,7 @@ import torch
 from torch import nn
 
 from gymfg_il.policies.configuration_mlp import MLPConfig
-from gymfg_il.policies.normalize import NormalizedPolicy, one_thread
+from gymfg_il.policies.normalize import NormalizedPolicy, OneThread
 
 
 class MLPPolicy(NormalizedPolicy):
@@ -65,7 +65,7 @@ class MLPPolicy(NormalizedPolicy):
     def step(self, observation: np.ndarray, state: Any = None) -> tuple[np.ndarray, Any]:
         """``NormalizedPolicy.step`` with the elementwise arithmetic (normalising, the memory,
         the action's scale) in numpy and only the layers in torch (on one thread,
-        ``one_thread``), on the CPU in eval mode:
+        ``OneThread``), on the CPU in eval mode:
         float32 operations rounded as torch's are, so the same action bit for bit, at about
         two thirds of the cost of a step (eval, PPO's evaluations and DAgger fly it at every
         step: tests/policies/test_agent.py)."""
@@ -81,7 +81,7 @@ class MLPPolicy(NormalizedPolicy):
                 state = [fresh()]
             obs = np.concatenate([obs, state[0](obs)])
         x = torch.from_numpy((obs - obs_mean.numpy()) / self.obs_norm.std.numpy())[None]
-        with torch.no_grad(), one_thread():
+        with torch.no_grad(), OneThread():
             y = (
                 self.net(x)
                 if self.integral is None
