@@ -45,7 +45,11 @@ class MLPPolicy(NormalizedPolicy):
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         """Normalised action predicted from raw observations (any leading dims); with
         ``memory``, observations already extended by the memory's columns."""
-        x = self.normalized(obs)
+        return self._head(self.normalized(obs))
+
+    def _head(self, x: torch.Tensor) -> torch.Tensor:
+        """The normalised action from normalised observations ``x``: the network, and with
+        memory its columns (the last) through the linear layer alone."""
         if self.integral is None:
             return self.net(x)
         k = self.n_memory
@@ -73,20 +77,12 @@ class MLPPolicy(NormalizedPolicy):
         if self.training or obs_mean.device.type != "cpu":
             return super().step(observation, state)
         obs = np.asarray(observation, dtype=np.float32)
-        k = self.n_memory
-        if k:
-            if state is None:  # as ``remember`` starts an episode: a fresh memory
-                fresh = self.memory_maker()
-                assert fresh is not None
-                state = [fresh()]
+        if self.n_memory:
+            state = state if state is not None else self._fresh_memories(1)
             obs = np.concatenate([obs, state[0](obs)])
         x = torch.from_numpy((obs - obs_mean.numpy()) / self.obs_norm.std.numpy())[None]
         with torch.no_grad(), OneThread():
-            y = (
-                self.net(x)
-                if self.integral is None
-                else self.net(x[..., :-k]) + self.integral(x[..., -k:])
-            )
+            y = self._head(x)
         norm = self.action_norm
         out: np.ndarray = (y.numpy()[0] * norm.std.numpy() + norm.mean.numpy()).astype(np.float64)
         return out, state
@@ -94,12 +90,16 @@ class MLPPolicy(NormalizedPolicy):
     def remember(self, obs: torch.Tensor, state: Any) -> tuple[torch.Tensor, Any]:
         """The observations extended by their memory, and the memory carried on."""
         if state is None:
-            fresh = self.memory_maker()
-            assert fresh is not None, "remember is called with memory only"
-            state = [fresh() for _ in range(len(obs))]
+            state = self._fresh_memories(len(obs))
         rows = obs.detach().cpu().numpy()
         memory = np.stack([m(row) for m, row in zip(state, rows, strict=True)])
         return torch.cat([obs, torch.as_tensor(memory, device=obs.device)], dim=-1), state
+
+    def _fresh_memories(self, n: int) -> list[Any]:
+        """A new memory for each of ``n`` rows: an episode's start."""
+        fresh = self.memory_maker()
+        assert fresh is not None, "called with memory only"
+        return [fresh() for _ in range(n)]
 
     def memory_maker(self) -> Callable[[], Any] | None:
         """What makes the fresh memory of an episode (a ``LoopMemory``), or None without

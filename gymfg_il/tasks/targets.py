@@ -224,8 +224,7 @@ class TargetTask(Task):
     def observe(self, state: np.ndarray, step: int) -> np.ndarray:
         n = self._n_vars
         obs = state[self._obs_idx_extended].astype(np.float32)  # its last three written below
-        targets = self._target_list
-        target = targets[step] if step < len(targets) else targets[-1]
+        target = self.target_value(step)
         err = target - state.item(self._var)  # Python floats: the same doubles, less overhead
         if self._angular:
             err = wrap_180(err)
