@@ -8,6 +8,7 @@
     python -m gymfg_il.collect reindex DIR                   # older logs: add message indexes
     python -m gymfg_il.collect dagger --policy P --out DIR   # DAgger with the controller
     python -m gymfg_il.collect manual --device keyboard --out DIR   # a person flies
+    python -m gymfg_il.collect web --out DIR --pilots 8      # people fly from their browsers
     python -m gymfg_il.collect export acmi LOG --out FLIGHT.acmi      # for Tacview
     python -m gymfg_il.collect export minari DIR --name gymfg/roll-v0 --root MINARI_DIR
 
@@ -119,6 +120,32 @@ def _flying(sub: Any) -> None:
     manual.add_argument(
         "--no-progress", action="store_true", help="no progress bar (--pilot synthetic)"
     )
+    from gymfg_il.web.config import WebConfig
+
+    web = sub.add_parser(
+        "web",
+        help="people fly from their browsers (a web cockpit on this machine; physics here), "
+        "every saved episode into one dataset",
+        description=textwrap.fill(
+            "Serve a web cockpit: each pilot opens the invite link printed for them and flies "
+            "in their browser (keyboard, mouse stick or gamepad) an aircraft simulated here "
+            "in real time; every step goes to OUT/logs and every saved episode to one "
+            "dataset in OUT/dataset. The keys are collect manual's. Ctrl-C stops the server "
+            "(an episode in flight is discarded; nothing saved is lost). Guide: "
+            "docs/guides/web.md.",
+            79,
+        ),
+        epilog=keys_help(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    cli.add_fields(
+        web,
+        WebConfig,
+        defaults={**unset, "agent_hz": MANUAL_HZ},
+        shown=shown,
+        flags={"agent_hz": "--fps"},
+    )
+    cli.add_fields(web, WebConfig, only=MANUAL_ONLY, shown={"gusts": "none"})
     dagger = sub.add_parser(
         "dagger",
         help="the policy flies, the controller labels what it visits, the data is aggregated "
@@ -162,7 +189,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     )
     sub = p.add_subparsers(
         dest="command",
-        metavar="{autopilot,manual,dagger,recover,repair,replay,reindex,export,RECIPE.toml}",
+        metavar="{autopilot,manual,web,dagger,recover,repair,replay,reindex,export,RECIPE.toml}",
     )
     _flying(sub)
     _tools(sub)
@@ -279,6 +306,14 @@ def _fly_by_hand(cfg: ManualConfig, show_progress: bool = True) -> int:
     return 0
 
 
+def _web(args: argparse.Namespace) -> int:
+    from gymfg_il import cli
+    from gymfg_il.web.config import WebConfig
+    from gymfg_il.web.server import WebServer
+
+    return WebServer(cli.build(WebConfig, args)).run()
+
+
 def _dagger(args: argparse.Namespace) -> int:
     from gymfg_il import cli
     from gymfg_il.learning.dagger import DaggerConfig, DaggerIteration
@@ -346,6 +381,7 @@ COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "autopilot": _autopilot,
     "recipe": _autopilot,
     "manual": _manual,
+    "web": _web,
     "dagger": _dagger,
     "recover": _recover,
     "repair": _repair,

@@ -4,10 +4,15 @@ nowhere else: a person's devices, or the synthetic pilot's hands on the same con
 
 A session of a person (no test or tool driving it) is refused at once when it could never
 get input (``manual.devices``); every refusal comes before the session folder is touched.
+
+A ``Plug`` flies a session from elsewhere (``collect web``: a browser): its input and window
+replace pygame's devices and window, its dataset updater is shared by every pilot of the
+server, and the session is otherwise the same loop.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -49,6 +54,24 @@ from gymfg_il.tasks.verdicts import TrackedError
 from gymfg_il.viz.camera import Camera
 
 
+@dataclass(frozen=True)
+class Plug:
+    """Where a session's input comes from and its frames go when not this machine's devices
+    and window (module docstring).
+
+    Attributes:
+        input: the session's input, made from the pilot's controller and the env.
+        window: the session's window (a sink of frames), made from the same and the flight.
+        updater: the dataset's updater, shared with other sessions writing the same folder.
+        log_tag: the start of the session's log file name (``logs/TAG-....mcap``).
+    """
+
+    input: Callable[[ManualController, AircraftEnv], Input]
+    window: Callable[[ManualController, AircraftEnv, FlightSpec], Window]
+    updater: DatasetUpdater
+    log_tag: str = "manual"
+
+
 @dataclass
 class Stages:
     """A built session: its env, the pilot's controller and takeover, and the loop's stages in
@@ -70,12 +93,18 @@ class Stages:
 
 
 def build(
-    config: ManualConfig, *, driven: bool, realtime: bool | None, draw: bool | None
+    config: ManualConfig,
+    *,
+    driven: bool,
+    realtime: bool | None,
+    draw: bool | None,
+    plug: Plug | None = None,
 ) -> Stages:
     """The stages of ``config``'s session. ``driven``: a test or tool drives it (a person's
-    devices are not checked); ``realtime`` and ``draw`` default to whether a person flies."""
+    devices are not checked); ``realtime`` and ``draw`` default to whether a person flies;
+    ``plug``: its input, window and updater come from elsewhere (``Plug``)."""
     synthetic = config.pilot == "synthetic"
-    if not driven and not synthetic:  # a person at the controls
+    if not driven and not synthetic and plug is None:  # a person at this machine
         check_person_can_fly(config.device)
     check_out_folder(config.out)
     flight = config.flight()
@@ -87,7 +116,9 @@ def build(
     realtime = not synthetic if realtime is None else realtime
     draw = not synthetic if draw is None else draw
     pilot_view = None if config.pilot_view == "none" else config.pilot_view
-    camera = Camera(320, 320, view=pilot_view, legible=True) if pilot_view and draw else None
+    camera = None
+    if pilot_view and draw and plug is None:
+        camera = Camera(320, 320, view=pilot_view, legible=True)
     human = _controller(config, env, window_size(camera is not None))
     takeover = Takeover(human, _assistant(config.assist, flight, env))
     # DART noise on what the synthetic pilot flies (drawn from each episode's seed); the
@@ -104,22 +135,29 @@ def build(
         images=images,
         image_size=config.image_size,
     )
-    log = _flight_log(config, env, flight, record, source, realtime)
-    updater = DatasetUpdater(config.out)
+    log = _flight_log(config, env, flight, record, source, realtime, plug)
+    updater = DatasetUpdater(config.out) if plug is None else plug.updater
     stats = SessionStats()
     # a person's dataset follows each saved episode; the synthetic pilot's is built at the end
     phases = Phases(
         rollout, log, takeover, updater, stats, seed=config.seed, build_each=not synthetic
     )
     window: Window = NoWindow()
-    if draw:
+    if plug is not None:
+        window = plug.window(human, env, flight)
+    elif draw:
         window = _window(config, flight, env, camera, human, person, assistant)
+    source_of_input = (
+        plug.input(human, env)
+        if plug is not None
+        else _input(config, env, human, takeover.assistant is not None)
+    )
     return Stages(
         env=env,
         human=human,
         takeover=takeover,
-        pace=Pace(env.dt, realtime),
-        input=_input(config, env, human, takeover.assistant is not None),
+        pace=Pace(env.dt, realtime, spin=plug is None),
+        input=source_of_input,
         phases=phases,
         rollout=rollout,
         log=log,
@@ -224,6 +262,7 @@ def _flight_log(
     record: dict[str, Any],
     source: str,
     realtime: bool,
+    plug: Plug | None,
 ) -> FlightLog:
     """The session's log; the pilot named by the config (the synthetic pilot by its skill)."""
     named = config.pilot_name
@@ -240,4 +279,5 @@ def _flight_log(
         gusty=flight.gusty,
         throttle=env.aircraft.profile.cruise_throttle,
         sim=env.world.slots[0].sim,
+        tag="manual" if plug is None else plug.log_tag,
     )

@@ -43,6 +43,7 @@ class FlightLog:
         gusty: the flight is in turbulence (the task's verdict allows for it).
         throttle: the throttle of ``last_action`` before the first step.
         sim: the aircraft's simulation, whose reset drew the episode's gusts (None: none).
+        tag: the start of the log file's name (``logs/TAG-<time>-<pid>-<us>.mcap``).
     """
 
     def __init__(
@@ -58,8 +59,9 @@ class FlightLog:
         gusty: bool,
         throttle: float,
         sim: Simulation | None = None,
+        tag: str = "manual",
     ) -> None:
-        self.out, self.record, self.task, self.dt = out, record, task, dt
+        self.out, self.record, self.task, self.dt, self.tag = out, record, task, dt, tag
         self.source, self.pilot_name, self.realtime = source, pilot_name, realtime
         self.gusty, self.sim = gusty, sim
         self.writer: TrajectoryWriter | None = None
@@ -73,7 +75,7 @@ class FlightLog:
 
     def _writer(self) -> TrajectoryWriter:
         if self.writer is None:
-            self.writer = TrajectoryWriter(new_log_path(self.out, "manual"), self.record)
+            self.writer = TrajectoryWriter(new_log_path(self.out, self.tag), self.record)
         return self.writer
 
     def start(self, seed: int, starts: list[Start]) -> None:
@@ -92,11 +94,17 @@ class FlightLog:
         )
 
     def log(
-        self, tick: Tick, observation: np.ndarray, read_at: float, period: float | None
+        self,
+        tick: Tick,
+        observation: np.ndarray,
+        read_at: float,
+        period: float | None,
+        delay: tuple[float, int] | None = None,
     ) -> str | None:
         """Log one flown step (``observation``: the pilot's next one; ``read_at``: the wall
-        clock its input was read at; ``period``: the loop period that led to its frame);
-        how the episode ended if this step ended it, else None."""
+        clock its input was read at; ``period``: the loop period that led to its frame;
+        ``delay``: an input from afar's round trip and age, ``inputs.source.Polled``); how
+        the episode ended if this step ended it, else None."""
         self._writer().log_tick(tick, read_at if self.realtime else None)
         (step,) = tick.steps
         self.last_action = step.action
@@ -107,6 +115,8 @@ class FlightLog:
         self.interventions += int(step.intervention)
         if self.realtime and period is not None and self.timing.add(period):
             self._late_at = time.perf_counter()
+        if self.realtime and delay is not None:
+            self.timing.add_delay(delay)
         if not tick.done:
             return None
         return step.reason or "terminated" if step.terminated else "time limit"

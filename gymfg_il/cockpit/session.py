@@ -29,7 +29,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from gymfg_il.cockpit.build import Stages, build
+from gymfg_il.cockpit.build import Plug, Stages, build
 from gymfg_il.cockpit.inputs.source import Seen
 from gymfg_il.cockpit.phases import SessionStats
 from gymfg_il.cockpit.windows.view import CockpitView
@@ -62,6 +62,8 @@ class ManualSession:
             the synthetic pilot flies as fast as the machine allows).
         draw: draw the window every frame (default: for a person; the synthetic pilot needs
             no pictures).
+        plug: the input, window and dataset updater of a session flown from elsewhere
+            (``cockpit.build.Plug``: ``collect web``'s browser pilots).
 
     A person's session brings the dataset up to date after every saved episode (so that
     quitting loses nothing); the synthetic pilot's once, at the end (the log keeps every
@@ -77,9 +79,10 @@ class ManualSession:
         *,
         realtime: bool | None = None,
         draw: bool | None = None,
+        plug: Plug | None = None,
     ) -> None:
         self.stages: Stages = build(
-            config, driven=on_frame is not None, realtime=realtime, draw=draw
+            config, driven=on_frame is not None, realtime=realtime, draw=draw, plug=plug
         )
         self.on_frame = on_frame
         self.display = self._look()
@@ -114,7 +117,7 @@ class ManualSession:
         running = s.phases.apply(polled.commands)
         if running and s.phases.state == "recording":
             tick = s.rollout.step()
-            ended = s.log.log(tick, s.rollout.current[0], polled.read_at, period)
+            ended = s.log.log(tick, s.rollout.current[0], polled.read_at, period, polled.delay)
             if ended is not None:
                 s.phases.finish(ended)
         s.updater.poll()
@@ -160,6 +163,8 @@ class ManualSession:
             message=phases.message or human.status,
             late=s.log.late_warning(phases.state == "recording"),
             show_help=phases.show_help,
+            seed=phases.next_seed,
+            started=phases.started,
         )
 
     def close(self) -> None:

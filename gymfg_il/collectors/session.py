@@ -32,6 +32,7 @@ from gymfg_il.tasks.verdicts import EpisodeVerdict, TrackedError
 from gymfg_il.workers import Workers
 
 DATASET = "dataset"
+INVITES = "invites.json"  # a web session's invites (``collect web``: ``web.invites``)
 log = logging.getLogger(__name__)
 
 __all__ = [
@@ -62,14 +63,14 @@ def check_out_folder(out: Path) -> None:
         foreign = sorted(
             p.name
             for p in out.iterdir()
-            if p.name not in (LOGS, DATASET)
+            if p.name not in (LOGS, DATASET, INVITES)
             and not p.name.startswith(DATASET + ".")
             and not p.name.startswith("policy-")
         )
         if foreign:
             raise ConfigError(
                 f"--out {out} holds {foreign[:5]}, which are not a collection session's; give a "
-                "new folder or one made by `collect` (logs/, dataset/)"
+                "new folder or one made by `collect` (logs/, dataset/, invites.json)"
             )
 
 

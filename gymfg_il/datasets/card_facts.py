@@ -101,7 +101,17 @@ def _timing(episodes: dict[str, list[Any]], shown: int = 20) -> str:
     timed = [t for t in timed if t[1] >= 0]
     if not timed:
         return "not recorded (no episode was flown in real time)"
-    said = [f"episode {i}: {r:.1f} Hz, jitter {j:.1f} ms, {n} late" for i, n, r, j in timed]
+    delay = [as_float(d) for d in episodes.get("gymfg/input_delay_ms", [-1.0] * len(late))]
+    age = [as_int(a) for a in episodes.get("gymfg/input_age_frames", [-1] * len(late))]
+
+    def afar(i: int) -> str:  # a pilot from afar (collect web): the input's delay seen
+        if i >= len(delay) or delay[i] < 0:
+            return ""
+        return f", input delay p99 {delay[i]:.0f} ms ({age[i]} frames)"
+
+    said = [
+        f"episode {i}: {r:.1f} Hz, jitter {j:.1f} ms, {n} late{afar(i)}" for i, n, r, j in timed
+    ]
     more = f"; {len(said) - shown} more" if len(said) > shown else ""
     total = sum(t[1] for t in timed)
     flagged = sum(t[1] > 0 for t in timed)

@@ -103,11 +103,14 @@ def _gusts(log: Log, start: dict[str, Any]) -> dict[str, Any]:
 
 
 def _timing(end: dict[str, Any]) -> dict[str, Any]:
-    """A real-time episode's timing (``cockpit.timing``): late frames, rate and jitter,
-    each -1 where the session ran as fast as it could or the log holds none."""
+    """A real-time episode's timing (``cockpit.timing``): late frames, rate and jitter, and
+    from afar the input's delay and age; each -1 where the session ran as fast as it could or
+    the log holds none."""
     late = end.get("late_frames")
     out: dict[str, Any] = {"late_frames": late if type(late) is int and late >= 0 else -1}
-    for key in ("rate_hz", "jitter_ms"):
+    age = end.get("input_age_frames")
+    out["input_age_frames"] = age if type(age) is int and age >= 0 else -1
+    for key in ("rate_hz", "jitter_ms", "input_delay_ms"):
         value = end.get(key)
         number = float(value) if isinstance(value, (int, float)) else math.nan  # a bool too
         out[key] = number if math.isfinite(number) and number >= 0 else -1.0

@@ -117,6 +117,14 @@ EPISODE_EVENT = {
         "late_frames": {"type": "integer", "description": "end, real time: frames late"},
         "rate_hz": {"type": "number", "description": "end, real time: frames per second"},
         "jitter_ms": {"type": "number", "description": "end, real time: std of loop periods"},
+        "input_delay_ms": {
+            "type": "number",
+            "description": "end, from afar (collect web): p99 of an input's round trip",
+        },
+        "input_age_frames": {
+            "type": "integer",
+            "description": "end, from afar: p99 of the frames between a frame and its input",
+        },
         "mark": {
             "type": "string",
             "enum": list(MARKS),

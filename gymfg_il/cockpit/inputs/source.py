@@ -43,10 +43,15 @@ class Seen:
 @dataclass(frozen=True, slots=True)
 class Polled:
     """One frame's input: the session commands read (in order) and the wall clock at which the
-    input was read (what a real-time session records with the frame)."""
+    input was read (what a real-time session records with the frame).
+
+    ``delay``: for an input from afar (``collect web``), the newest input's round trip (s,
+    from sending the frame it answered to its arrival) and its age in frames (this frame's
+    number less the answered one's); None for a local input."""
 
     commands: list[str]
     read_at: float
+    delay: tuple[float, int] | None = None
 
 
 class Input(Protocol):

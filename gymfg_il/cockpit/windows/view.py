@@ -32,6 +32,8 @@ class CockpitView:
         message: the session's line (what to do next), or a device's status.
         late: the warning while frames come late ("" when none).
         show_help: show the keys.
+        seed: the seed of the episode in flight (or of the next one).
+        started: episodes started so far (a new number: a new episode).
     """
 
     status: str
@@ -47,6 +49,8 @@ class CockpitView:
     message: str
     late: str
     show_help: bool
+    seed: int = 0
+    started: int = 0
 
 
 class Window(Protocol):

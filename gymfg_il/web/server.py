@@ -1,0 +1,440 @@
+"""The web cockpit's server (``python -m gymfg_il.collect web``).
+
+Starlette on uvicorn (ASGI, with the ``websockets`` library under it; ``docs/guides/web.md``
+says why): ``/fly`` serves the cockpit page from this package (``web/static``: no CDN, nothing
+downloaded), ``/ws`` is each pilot's websocket (``web.protocol``).
+
+Physics stays here: each pilot who opens their invite gets a cockpit session of their own
+(``cockpit.session``, the same loop as ``collect manual``) on a thread, stepped in real time
+at the flight's rate; the page draws the readings it is sent and sends back what the pilot
+does (``web.link``). Every pilot's episodes go to their own MCAP log in ``OUT/logs`` as they
+fly, and one dataset updater (one helper process, the only writer) keeps ``OUT/dataset`` up to
+date with every saved episode of every pilot. A dropped socket discards the episode in flight
+and nothing saved; the same invite resumes; ``kill -9`` of the server loses no saved episode
+(``collect recover OUT`` rebuilds the dataset from the logs).
+
+What a page may do is checked: an invite token to fly (``web.invites``), messages of bounded
+size, rate and content (``web.protocol``), a bounded number of sockets; a socket that breaks
+a rule is closed with the reason and the server flies on.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import re
+import sys
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from importlib import resources
+from typing import Any
+
+from gymfg_il.cockpit.build import Plug
+from gymfg_il.cockpit.updater import DatasetUpdater
+from gymfg_il.collectors.session import check_appendable, check_out_folder
+from gymfg_il.envs.options import FlightOptions
+from gymfg_il.errors import ConfigError
+from gymfg_il.web.config import WebConfig
+from gymfg_il.web.invites import Invite, find, invites, names_from
+from gymfg_il.web.link import PilotLink, WebInput, WebWindow
+from gymfg_il.web.protocol import (
+    HELLO_S,
+    MAX_MESSAGE_BYTES,
+    ProtocolError,
+    RateLimit,
+    decode,
+    hello,
+    inputs,
+)
+
+log = logging.getLogger(__name__)
+
+SOCKETS_PER_PILOT = 4  # open sockets allowed (flying or not yet) per pilot slot
+NEEDS = "the web cockpit needs its extra: pip install -e '.[web]' (starlette, uvicorn, websockets)"
+
+
+class SharedUpdater(DatasetUpdater):
+    """One dataset updater for every pilot's session (``cockpit.updater``: one helper process
+    writes the dataset). A session's end leaves it running; ``shutdown`` finishes it."""
+
+    def __init__(self, out: Any) -> None:
+        super().__init__(out)
+        self.lock = threading.RLock()
+
+    def warm(self) -> None:
+        with self.lock:
+            super().warm()
+
+    def request(self) -> None:
+        with self.lock:
+            super().request()
+
+    def poll(self) -> None:
+        if self.lock.acquire(blocking=False):  # another pilot's loop is polling: skip
+            try:
+                super().poll()
+            finally:
+                self.lock.release()
+
+    def close(self) -> bool:
+        """A pilot's session ended: the dataset goes on serving the others."""
+        return self.built
+
+    def shutdown(self) -> bool:
+        """Finish every outstanding build and stop the helper; True if a dataset was built."""
+        with self.lock:
+            return super().close()
+
+
+@dataclass
+class Pilot:
+    """One invite's pilot: their session (a thread), its link, the socket flying it."""
+
+    invite: Invite
+    next_seed: int
+    link: PilotLink | None = None
+    thread: threading.Thread | None = None
+    device: str | None = None
+    socket: Any = None
+    saved: int = 0
+
+
+def _file_name(name: str) -> str:
+    """A pilot's name as part of a log file's name."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", name)[:40] or "pilot"
+
+
+class WebServer:
+    """Serve ``config``'s web cockpit (module docstring); ``say`` prints the server's output
+    (pilots joining and leaving, episodes saved and discarded)."""
+
+    def __init__(self, config: WebConfig, say: Callable[[str], None] | None = None) -> None:
+        self.config = config
+        self.say = say or (lambda text: print(text, flush=True))
+        check_out_folder(config.out)
+        flight = config.flight()
+        env = flight.make_env()
+        try:
+            check_appendable(
+                config.out,
+                env.observation_names,
+                flight.agent_hz,
+                None,
+                list(config.images),
+                config.image_size,
+            )
+        finally:
+            env.close()
+        self.flight_options = {
+            k: (str(v) if not isinstance(v, (int, float, bool, str, dict)) else v)
+            for k, v in FlightOptions.given(config).items()
+        }
+        self.flight_options["agent_hz"] = flight.agent_hz
+        names = (
+            names_from(config.invites)
+            if config.invites is not None
+            else [f"pilot-{k + 1}" for k in range(config.pilots)]
+        )
+        self.invites = invites(config.out, names, config.seed)
+        self.pilots = {i.name: Pilot(i, i.seed) for i in self.invites}
+        self.updater = SharedUpdater(config.out)
+        self.sockets = 0
+        self.port = config.port
+        self.lock = threading.Lock()
+        self.serving = threading.Event()
+        self._uvicorn: Any = None
+
+    # -- the app --------------------------------------------------------------------------
+    def app(self) -> Any:
+        """The ASGI app: the page, its script, and the pilots' websocket."""
+        try:
+            from starlette.applications import Starlette
+            from starlette.responses import HTMLResponse, Response
+            from starlette.routing import Route, WebSocketRoute
+        except ImportError as err:
+            raise ConfigError(f"{NEEDS} ({err})") from None
+
+        static = resources.files("gymfg_il.web") / "static"
+        page = (static / "cockpit.html").read_text(encoding="utf-8")
+        script = (static / "cockpit.js").read_text(encoding="utf-8")
+        headers = {
+            "Cache-Control": "no-store",
+            "X-Content-Type-Options": "nosniff",
+            "Content-Security-Policy": "default-src 'self'; connect-src 'self' ws: wss:; "
+            "style-src 'self' 'unsafe-inline'",
+            "Referrer-Policy": "no-referrer",
+        }
+
+        async def index(request: Any) -> Any:
+            return HTMLResponse(
+                "<!doctype html><title>GymFG-IL web cockpit</title><p>Open the invite link "
+                "you were given (it looks like /fly#invite=...).</p>",
+                headers=headers,
+            )
+
+        async def fly(request: Any) -> Any:
+            return HTMLResponse(page, headers=headers)
+
+        async def js(request: Any) -> Any:
+            return Response(script, media_type="text/javascript", headers=headers)
+
+        return Starlette(
+            routes=[
+                Route("/", index),
+                Route("/fly", fly),
+                Route("/cockpit.js", js),
+                WebSocketRoute("/ws", self.socket),
+            ]
+        )
+
+    # -- a pilot's socket -----------------------------------------------------------------
+    async def socket(self, websocket: Any) -> None:
+        """One page's websocket, from hello to close (module docstring)."""
+        limit = SOCKETS_PER_PILOT * len(self.pilots)
+        if self.sockets >= limit:
+            await websocket.close(code=1013)  # refused before it is accepted
+            return
+        self.sockets += 1
+        pilot: Pilot | None = None
+        try:
+            await websocket.accept()
+            pilot = await self._join(websocket)
+            if pilot is not None:
+                await self._fly(websocket, pilot)
+        except ProtocolError as err:
+            await self._close(websocket, 1008, err.reason, pilot)
+        except Exception as err:  # the server flies on
+            if type(err).__name__ not in ("WebSocketDisconnect", "ConnectionClosed"):
+                log.exception("a pilot's socket failed")
+                await self._close(websocket, 1011, f"server error: {type(err).__name__}", pilot)
+        finally:
+            self.sockets -= 1
+            if pilot is not None and pilot.socket is websocket:
+                pilot.socket = None
+                if pilot.link is not None:
+                    pilot.link.detach()
+                self.say(f"pilot {pilot.invite.name} left")
+
+    async def _close(self, websocket: Any, code: int, reason: str, pilot: Pilot | None) -> None:
+        who = f"pilot {pilot.invite.name}" if pilot is not None else "a page"
+        self.say(f"{who}: socket closed ({reason})")
+        with contextlib.suppress(Exception):
+            await websocket.close(code=code, reason=reason)
+
+    async def _receive(self, websocket: Any) -> str | bytes | None:
+        """The next message's data, None once the page went."""
+        message = await websocket.receive()
+        if message["type"] == "websocket.disconnect":
+            return None
+        data = message.get("text")
+        return data if data is not None else message.get("bytes", b"")
+
+    async def _join(self, websocket: Any) -> Pilot | None:
+        try:
+            data = await asyncio.wait_for(self._receive(websocket), HELLO_S)
+        except TimeoutError:
+            raise ProtocolError(f"no hello within {HELLO_S:g} s") from None
+        if data is None:
+            return None
+        said = hello(decode(data))
+        invite = find(self.invites, said.invite)
+        if invite is None:
+            raise ProtocolError("no such invite")
+        pilot = self.pilots[invite.name]
+        if self.config.episodes and pilot.saved >= self.config.episodes:
+            raise ProtocolError(f"you have saved your {pilot.saved} episode(s); thank you")
+        flying = sum(p.socket is not None and p is not pilot for p in self.pilots.values())
+        if flying >= self.config.pilots:
+            raise ProtocolError(f"the server is full ({self.config.pilots} pilots); try later")
+        if pilot.socket is not None:  # the newest page flies
+            old, pilot.socket = pilot.socket, None
+            await self._close(old, 1008, "this invite was opened again elsewhere", pilot)
+        pilot.socket = websocket
+        await asyncio.to_thread(self._session, pilot, said.device)
+        assert pilot.link is not None
+        if pilot.link.failed is not None:
+            raise ProtocolError(f"the session could not start: {pilot.link.failed}")
+        self.say(f"pilot {invite.name} joined ({said.device})")
+        return pilot
+
+    async def _fly(self, websocket: Any, pilot: Pilot) -> None:
+        link = pilot.link
+        assert link is not None and link.welcome is not None
+        loop = asyncio.get_running_loop()
+        newest: list[bytes] = []
+        wake = asyncio.Event()
+
+        def put(data: bytes) -> None:
+            newest[:] = [data]  # only the newest frame waits
+            wake.set()
+
+        def sender(data: bytes) -> None:  # from the session's thread
+            loop.call_soon_threadsafe(put, data)
+
+        from gymfg_il.web.protocol import encode
+
+        await websocket.send_text(encode(link.welcome).decode())
+        link.attach(sender)
+        send = asyncio.create_task(self._send(websocket, newest, wake, link))
+        try:
+            rate, seq = RateLimit(), -1
+            while pilot.socket is websocket:
+                data = await self._receive(websocket)
+                if data is None:
+                    return
+                rate.take(time.monotonic())
+                message = inputs(decode(data), seq)
+                seq = message.seq
+                link.received(message)
+        finally:
+            send.cancel()
+            with contextlib.suppress(asyncio.CancelledError, Exception):
+                await send
+
+    async def _send(
+        self, websocket: Any, newest: list[bytes], wake: asyncio.Event, link: PilotLink
+    ) -> None:
+        while True:
+            await wake.wait()
+            wake.clear()
+            if newest:
+                data = newest.pop()
+                if data:
+                    await websocket.send_text(data.decode())
+            if link.close_reason is not None:
+                await websocket.close(code=1000, reason=link.close_reason[:120])
+                return
+
+    # -- a pilot's session ----------------------------------------------------------------
+    def _session(self, pilot: Pilot, device: str) -> None:
+        """Start the pilot's session (or keep it: the same device), and wait until it flies."""
+        with self.lock:
+            if pilot.thread is not None and pilot.thread.is_alive():
+                if pilot.device == device:
+                    return
+                assert pilot.link is not None
+                pilot.link.stop = True  # another device: a new session, the next seed on
+                pilot.thread.join()
+            link = PilotLink(pilot.invite.name)
+            pilot.link, pilot.device = link, device
+            pilot.thread = threading.Thread(
+                target=self._run, args=(pilot, link, device), name=f"pilot-{pilot.invite.name}"
+            )
+            pilot.thread.daemon = True
+            pilot.thread.start()
+        link.ready.wait(60)
+        if not link.ready.is_set():
+            link.failed = "it did not start within 60 s"
+
+    def _run(self, pilot: Pilot, link: PilotLink, device: str) -> None:
+        from gymfg_il.cockpit.session import ManualSession
+
+        config = self.config.pilot_session(pilot.invite.name, pilot.next_seed, device)
+        options = self.flight_options
+        say = self.say
+
+        def window(human: Any, env: Any, flight: Any) -> WebWindow:
+            return WebWindow(link, human, env, flight, options, say)
+
+        plug = Plug(
+            input=lambda human, env: WebInput(link, human, env.dt),
+            window=window,
+            updater=self.updater,
+            log_tag=f"web-{_file_name(pilot.invite.name)}",
+        )
+        try:
+            session = ManualSession(config, plug=plug, realtime=True, draw=True)
+        except Exception as err:  # said to the page, and here
+            link.failed = f"{type(err).__name__}: {err}"
+            log.exception("pilot %s: the session did not start", pilot.invite.name)
+            link.ready.set()
+            return
+        link.ready.set()
+        try:
+            stats = session.run()
+        finally:
+            pilot.next_seed = session.stages.phases.next_seed
+        pilot.saved += stats.saved
+        if not link.stop:  # the pilot saved every episode asked for
+            link.close_page(f"thank you: you saved your {pilot.saved} episode(s)")
+
+    # -- serving --------------------------------------------------------------------------
+    def run(self) -> int:
+        """Serve until interrupted (Ctrl-C or SIGTERM), then finish the dataset."""
+        try:
+            import uvicorn
+        except ImportError as err:
+            raise ConfigError(f"{NEEDS} ({err})") from None
+        app = self.app()
+        if self.config.open_to_others:
+            self.say(
+                f"WARNING: serving on {self.config.host}, beyond this machine: anyone who can "
+                "reach it and holds an invite flies, over plain HTTP; put it behind a TLS "
+                "proxy (docs/guides/web.md)"
+            )
+        server = uvicorn.Server(
+            uvicorn.Config(
+                app,
+                host=self.config.host,
+                port=self.config.port,
+                ws="websockets-sansio",
+                ws_max_size=MAX_MESSAGE_BYTES,
+                log_level="warning",
+                lifespan="off",
+            )
+        )
+        self._uvicorn = server
+        try:
+            asyncio.run(self._serve(server))
+        except KeyboardInterrupt:  # uvicorn hands Ctrl-C back once it has shut down
+            pass
+        except SystemExit as exit_:  # uvicorn's startup failure (the port is taken)
+            raise ConfigError(
+                f"cannot serve on {self.config.host}:{self.config.port} (see above); "
+                "give another --port, or 0 for any free one"
+            ) from exit_
+        finally:
+            self.close()
+        return 0
+
+    async def _serve(self, server: Any) -> None:
+        task = asyncio.create_task(server.serve())
+        while not server.started and not task.done():
+            await asyncio.sleep(0.02)
+        if server.started:
+            self.port = server.servers[0].sockets[0].getsockname()[1]
+            self._announce()
+            self.serving.set()
+        await task
+
+    def _announce(self) -> None:
+        base = f"http://{self.config.host}:{self.port}"
+        if ":" in self.config.host:
+            base = f"http://[{self.config.host}]:{self.port}"
+        self.say(f"serving the web cockpit at {base}/ (Ctrl-C stops it)")
+        self.say(f"data: {self.config.out}/logs (every step) and {self.config.out}/dataset")
+        for invite in self.invites:
+            self.say(f"invite {invite.name}: {invite.link(base)}")
+
+    def stop(self) -> None:
+        """Ask the server to stop (from another thread)."""
+        if self._uvicorn is not None:
+            self._uvicorn.should_exit = True
+
+    def close(self) -> None:
+        """End every pilot's session (an episode in flight is discarded) and finish the
+        dataset."""
+        for pilot in self.pilots.values():
+            if pilot.link is not None:
+                pilot.link.stop = True
+        for pilot in self.pilots.values():
+            if pilot.thread is not None:
+                pilot.thread.join(timeout=30)
+        built = self.updater.shutdown()
+        saved = sum(p.saved for p in self.pilots.values())
+        where = f"{self.config.out}/dataset" if built else "none built"
+        self.say(f"saved {saved} episode(s) from {len(self.pilots)} invite(s); dataset: {where}")
+        sys.stdout.flush()
