@@ -23,6 +23,16 @@ class Pace:
         self._deadline: float | None = None
         self._last_start: float | None = None
 
+    def restart(self) -> None:
+        """Count the next frame's period from now (a frame that reset the aircraft, some ms
+        of trimming, gives the next frame a whole period; the pilot's first answer to the new
+        episode has it to arrive in)."""
+        now = time.perf_counter()
+        if self._deadline is not None:
+            self._deadline = now
+        if self._last_start is not None:
+            self._last_start = now
+
     def wait(self) -> float | None:
         """Wait for the next frame's start (real time only); the loop period since the last."""
         if self._deadline is None:

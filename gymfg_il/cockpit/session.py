@@ -114,6 +114,7 @@ class ManualSession:
         if self.on_frame is not None:
             self.on_frame(frame, self)
         polled = s.input.poll(self._seen())
+        started = s.phases.started
         running = s.phases.apply(polled.commands)
         if running and s.phases.state == "recording":
             tick = s.rollout.step()
@@ -121,6 +122,8 @@ class ManualSession:
             if ended is not None:
                 s.phases.finish(ended)
         s.updater.poll()
+        if s.phases.started != started:  # the reset's trimming took part of this frame
+            s.pace.restart()
         # once a frame, after what changed it: the window draws it now, and the synthetic
         # pilot reads the same at the start of the next frame
         self.display = self._look()

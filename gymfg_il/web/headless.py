@@ -61,6 +61,16 @@ def _pilot(welcome: dict[str, Any], skill: float) -> tuple[Any, Any]:
         JoystickBindings(),
         size,
     )
+    # its first answer costs tens of ms (first calls through the controller's code): make it
+    # here, so that the first frame of a flight is answered in time like every other
+    from gymfg_il.display.readings import display_of
+
+    env.reset(seed=0)
+    controls = np.array([0.0, 0.0, 0.0, throttle])
+    pilot.reset(0)
+    pilot.start_from(controls)
+    for step in range(3):
+        pilot.events(display_of(env.task, env.world.slots[0].state, step), controls)
     return pilot, env
 
 

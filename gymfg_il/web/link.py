@@ -21,7 +21,6 @@ page discards the episode in flight and closes the page's socket, the session st
 from __future__ import annotations
 
 import collections
-import logging
 import threading
 import time
 from collections.abc import Callable
@@ -38,8 +37,6 @@ from gymfg_il.envs.single import AircraftEnv
 from gymfg_il.manual.controller import ManualController
 from gymfg_il.web.protocol import Input, encode
 
-log = logging.getLogger(__name__)
-
 SENT_KEPT = 256  # frames whose send time is kept (an input answering an older one is old)
 
 
@@ -51,8 +48,8 @@ class PilotLink:
     thread (the server hands them to its event loop).
     """
 
-    def __init__(self, name: str) -> None:
-        self.name = name
+    def __init__(self, name: str, say: Callable[[str], None] = print) -> None:
+        self.name, self.say = name, say
         self.inbox: collections.deque[tuple[Input, float]] = collections.deque()
         self.lock = threading.Lock()
         self.sender: Callable[[bytes], None] | None = None
@@ -144,8 +141,8 @@ class WebInput:
             events = []
             if seen.phase != "idle":
                 commands.append("discard")
-                why = "the page quit" if link.quit else "the connection dropped"
-                log.warning("pilot %s: %s; the episode in flight was discarded", link.name, why)
+                why = "the server stops" if link.stop else "the connection dropped"
+                link.say(f"pilot {link.name}: {why}; the episode in flight was discarded")
         commands += self.human.handle(events, self.dt)
         for event in events:
             if event.type == pg.KEYDOWN:
@@ -154,6 +151,10 @@ class WebInput:
                     link.quit = True
                     if seen.phase != "idle":
                         commands.append("discard")
+                        link.say(
+                            f"pilot {link.name}: the page quit; the episode in flight was "
+                            "discarded"
+                        )
                     link.close_page(
                         "you quit (an episode in flight was discarded); open your "
                         "invite again to fly on"

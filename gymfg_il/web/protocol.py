@@ -87,10 +87,17 @@ def decode(data: str | bytes) -> dict[str, Any]:
     return message
 
 
+def _fields(message: dict[str, Any], known: tuple[str, ...]) -> None:
+    unknown = sorted(set(message) - set(known))
+    if unknown:
+        raise ProtocolError(f"unknown field {str(unknown[0])[:20]!r}; want {', '.join(known)}")
+
+
 def hello(message: dict[str, Any]) -> Hello:
     """The first message: an invite and a device."""
     if message.get("type") != "hello":
         raise ProtocolError("say hello first: {type: hello, invite, device}")
+    _fields(message, ("type", "invite", "device"))
     invite, device = message.get("invite"), message.get("device", "keyboard")
     if not isinstance(invite, str) or not 8 <= len(invite) <= 64 or set(invite) - TOKEN_CHARS:
         raise ProtocolError("no such invite")
@@ -139,6 +146,7 @@ def inputs(message: dict[str, Any], last_seq: int) -> Input:
     """An input message after the one numbered ``last_seq``."""
     if message.get("type") != "input":
         raise ProtocolError(f"message type {str(message.get('type'))[:20]!r}: want input")
+    _fields(message, ("type", "seq", "at", "frame", "events"))
     seq = _int(message.get("seq"), last_seq + 1, 2**53, "seq (it must grow)")
     at = _number(message.get("at"), 0.0, 1e15, "at")
     frame = _int(message.get("frame"), -1, 2**53, "frame")

@@ -318,7 +318,7 @@ class WebServer:
                 assert pilot.link is not None
                 pilot.link.stop = True  # another device: a new session, the next seed on
                 pilot.thread.join()
-            link = PilotLink(pilot.invite.name)
+            link = PilotLink(pilot.invite.name, self.say)
             pilot.link, pilot.device = link, device
             pilot.thread = threading.Thread(
                 target=self._run, args=(pilot, link, device), name=f"pilot-{pilot.invite.name}"
@@ -401,6 +401,9 @@ class WebServer:
         return 0
 
     async def _serve(self, server: Any) -> None:
+        # the dataset's helper starts now, not as the first pilot's first episode starts (a
+        # fork then would hold up that pilot's frames)
+        await asyncio.to_thread(self.updater.warm)
         task = asyncio.create_task(server.serve())
         while not server.started and not task.done():
             await asyncio.sleep(0.02)
@@ -418,6 +421,7 @@ class WebServer:
         self.say(f"data: {self.config.out}/logs (every step) and {self.config.out}/dataset")
         for invite in self.invites:
             self.say(f"invite {invite.name}: {invite.link(base)}")
+        self.say(f"{len(self.invites)} invite(s); waiting for pilots")
 
     def stop(self) -> None:
         """Ask the server to stop (from another thread)."""
