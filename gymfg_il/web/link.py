@@ -152,8 +152,7 @@ class WebInput:
                     if seen.phase != "idle":
                         commands.append("discard")
                         link.say(
-                            f"pilot {link.name}: the page quit; the episode in flight was "
-                            "discarded"
+                            f"pilot {link.name}: the page quit; the episode in flight was discarded"
                         )
                     link.close_page(
                         "you quit (an episode in flight was discarded); open your "

@@ -181,9 +181,13 @@ class WebServer:
         async def js(request: Any) -> Any:
             return Response(script, media_type="text/javascript", headers=headers)
 
+        async def no_icon(request: Any) -> Any:
+            return Response(status_code=204)
+
         return Starlette(
             routes=[
                 Route("/", index),
+                Route("/favicon.ico", no_icon),
                 Route("/fly", fly),
                 Route("/cockpit.js", js),
                 WebSocketRoute("/ws", self.socket),

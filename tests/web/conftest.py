@@ -3,6 +3,7 @@ its output: the address, each pilot's invite, and what it says as pilots come an
 
 from __future__ import annotations
 
+import contextlib
 import os
 import queue
 import re
@@ -52,10 +53,8 @@ class Served:
             seen = len(self.lines)
             if self.proc.poll() is not None and self._queue.empty():
                 break
-            try:
+            with contextlib.suppress(queue.Empty):
                 self._queue.get(timeout=0.2)
-            except queue.Empty:
-                pass
         raise AssertionError(f"no line matching {pattern!r}; output:\n" + "\n".join(self.lines))
 
     def said(self, pattern: str) -> list[str]:
@@ -81,8 +80,17 @@ def serve(tmp_path):
         env = {**os.environ, "HF_HUB_OFFLINE": "1", "SDL_VIDEODRIVER": "dummy"}
         env["PYTHONUNBUFFERED"] = "1"
         proc = subprocess.Popen(
-            [sys.executable, "-m", "gymfg_il.collect", "web", "--out", str(out), "--port", "0"]
-            + list(args),
+            [
+                sys.executable,
+                "-m",
+                "gymfg_il.collect",
+                "web",
+                "--out",
+                str(out),
+                "--port",
+                "0",
+                *list(args),
+            ],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,

@@ -86,9 +86,14 @@ def test_a_dropped_page_loses_its_episode_in_flight_and_the_same_invite_flies_it
                     return message["seed"]  # leave, mid-episode
                 await ws.send(
                     orjson.dumps(
-                        {"type": "input", "seq": seq, "at": 1.0, "frame": message["n"],
-                         "events": events}
-                    )  # fmt: skip
+                        {
+                            "type": "input",
+                            "seq": seq,
+                            "at": 1.0,
+                            "frame": message["n"],
+                            "events": events,
+                        }
+                    )
                 )
 
     seed = asyncio.run(leave_mid_episode())
@@ -120,9 +125,14 @@ def test_quit_on_the_page_closes_its_socket_with_the_reason_and_the_session_wait
                         events += [["down", "q"], ["up", "q"]] if seq == 10 else []
                         await ws.send(
                             orjson.dumps(
-                                {"type": "input", "seq": seq, "at": 0, "frame": message["n"],
-                                 "events": events}
-                            )  # fmt: skip
+                                {
+                                    "type": "input",
+                                    "seq": seq,
+                                    "at": 0,
+                                    "frame": message["n"],
+                                    "events": events,
+                                }
+                            )
                         )
             except ConnectionClosed:
                 pass

@@ -35,15 +35,19 @@ function connect() {
   if (!invite) { stateText.textContent = "no invite in this link"; return; }
   wanted = true;
   const scheme = location.protocol === "https:" ? "wss:" : "ws:";
-  ws = new WebSocket(scheme + "//" + location.host + "/ws");
+  const socket = new WebSocket(scheme + "//" + location.host + "/ws");
+  ws = socket;
   stateText.textContent = "connecting";
-  ws.onopen = () => {
-    ws.send(JSON.stringify({ type: "hello", invite: invite, device: deviceSelect.value }));
+  stateText.className = "";
+  socket.onopen = () => {
+    socket.send(JSON.stringify({ type: "hello", invite: invite, device: deviceSelect.value }));
   };
-  ws.onmessage = (event) => {
+  socket.onmessage = (event) => {
+    if (socket !== ws) return;
     const message = JSON.parse(event.data);
     if (message.type === "welcome") {
       welcome = message;
+      closedWhy = "";
       stateText.textContent = "flying as " + message.pilot + " (" + message.device + ")";
       calibrateText.hidden = message.device !== "joystick";
       pad = { index: -1, axes: [], buttons: [], centre: [] };
@@ -55,7 +59,8 @@ function connect() {
       requestAnimationFrame(draw);
     }
   };
-  ws.onclose = (event) => {
+  socket.onclose = (event) => {
+    if (socket !== ws) return;  // a socket this page replaced
     closedWhy = event.reason || ("connection closed (" + event.code + ")");
     stateText.textContent = closedWhy;
     stateText.className = "bad";
@@ -76,9 +81,10 @@ function answer() {
 
 document.getElementById("join").onclick = () => {
   if (retry) clearTimeout(retry);
-  if (ws) ws.close();
-  closedWhy = ""; stateText.className = "";
+  const old = ws;
+  closedWhy = "";
   connect();
+  if (old) old.close();
 };
 
 // -- input -----------------------------------------------------------------------------
@@ -349,7 +355,7 @@ function slip(beta, targets) {
 
 function controls() {
   // the stick (aileron, elevator) with its trim, the rudder and the throttle
-  const c = frame.controls, trim = frame.trim, x0 = 60, y0 = 560, s = 70;
+  const c = frame.controls, trim = frame.trim, x0 = 60, y0 = 640, s = 70;
   text("STICK", x0 - 20, y0 - s - 12, DIM, 12);
   ctx.strokeStyle = EDGE; ctx.strokeRect(x0 - s + 20, y0 - s, 2 * s, 2 * s);
   dot(x0 + 20 + trim[0] * s, y0 + trim[1] * s, 4, DIM);
@@ -404,7 +410,7 @@ function panel(readings) {
 }
 
 function words() {
-  const f = frame, left = 330, top = 600;
+  const f = frame, left = 400, top = 560;
   if (f.message) text(f.message, left, top, YELLOW, 15);
   let lines = [];
   if (f.status === "idle") lines = f.debrief ? f.debrief.lines : welcome.briefing;
@@ -420,3 +426,4 @@ function help() {
 
 requestAnimationFrame(draw);
 if (invite) connect();
+else stateText.textContent = "no invite in this link: open the link you were given";
