@@ -30,6 +30,7 @@ class Row:
     higher_is_better: bool = True
     detail: list[str] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
+    at_most: bool = False  # a lower-is-better target the value may equal (<=, not <)
 
     def json(self) -> dict[str, Any]:
         return {
@@ -44,8 +45,12 @@ class Row:
     def verdict(self) -> str:
         if self.target is None:
             return "(reported)"
-        ok = self.value >= self.target if self.higher_is_better else self.value < self.target
-        sign = ">=" if self.higher_is_better else "<"
+        if self.higher_is_better:
+            ok, sign = self.value >= self.target, ">="
+        elif self.at_most:
+            ok, sign = self.value <= self.target, "<="
+        else:
+            ok, sign = self.value < self.target, "<"
         return f"(target {sign} {self.target:,g}: {'met' if ok else 'NOT MET'})"
 
 

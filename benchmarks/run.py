@@ -8,7 +8,8 @@ dataset_build_frames_per_s and train_pipeline_frames_per_s (``data``),
 rollout_workers_vs_ceiling and ray_vs_pool_2_workers (``workers``),
 camera_frames_per_s (``camera``),
 manual_loop_p99_period_error_ms, synthetic_pilot_x_realtime and
-input_to_record_p99_steps (``manual``),
+input_to_record_p99_steps (``manual``), web_8_pilots_p99_period_error_ms and
+web_input_to_record_p99_steps (``web``),
 online_{2,8,16}_teams_steps_per_s and online_2_teams_pinned_steps_per_s (``online``),
 rl_sampling_vs_physics_bound and rl_envs_alone_vs_physics_bound (its ceiling) with cores
 and 4 x cores envs (``rl``). Ratios are medians of paired rounds (see ``benchmarks.common``).
@@ -23,7 +24,7 @@ from pathlib import Path
 
 from benchmarks.common import Row, print_rows
 
-CONCERNS = ("physics", "workers", "data", "camera", "manual", "online", "rl")
+CONCERNS = ("physics", "workers", "data", "camera", "manual", "web", "online", "rl")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -167,6 +167,10 @@ def serve(out: Path, requests: IO[str], answers: IO[str]) -> None:
 
 
 if __name__ == "__main__":
+    # the real-time loops it serves (a person's frames, a web server's pilots) come first:
+    # on a machine of few cores a build runs beside them at a lower priority
+    with contextlib.suppress(OSError):
+        os.nice(10)
     answers = os.fdopen(os.dup(1), "w")  # answers get a descriptor of their own;
     os.dup2(2, 1)  # whatever else writes to stdout (a library, C code) goes to stderr
     from gymfg_il.datasets import lerobot_api

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import os
+import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -52,7 +53,8 @@ def check_out_folder(out: Path) -> None:
         raise ConfigError(f"--out {out} is a file; give a folder")
     try:
         out.mkdir(parents=True, exist_ok=True)
-        probe = out / f".gymfg-write-check-{os.getpid()}"
+        # of this thread: the sessions of a web server check the same folder at once
+        probe = out / f".gymfg-write-check-{os.getpid()}-{threading.get_ident()}"
         probe.touch()
         probe.unlink()
     except OSError as err:

@@ -351,6 +351,9 @@ class WebServer:
         )
         try:
             session = ManualSession(config, plug=plug, realtime=True, draw=True)
+            # a first reset builds and trims what later ones reuse (tens of ms): done now, not
+            # in a frame while other pilots fly (a reset is seeded: the flight is the same)
+            session.stages.env.reset(seed=config.seed)
         except Exception as err:  # said to the page, and here
             link.failed = f"{type(err).__name__}: {err}"
             log.exception("pilot %s: the session did not start", pilot.invite.name)
