@@ -120,19 +120,31 @@ def _flying(sub: Any) -> None:
     manual.add_argument(
         "--no-progress", action="store_true", help="no progress bar (--pilot synthetic)"
     )
+    _web_parser(sub, unset, shown)
+    dagger = sub.add_parser(
+        "dagger",
+        help="the policy flies, the controller labels what it visits, the data is aggregated "
+        "and the policy retrained",
+    )
+    cli.add_fields(dagger, DaggerConfig)
+
+
+def _web_parser(sub: Any, unset: dict[str, Any], shown: dict[str, str]) -> None:
+    """``collect web``: the flight's options as ``collect manual``'s, and the server's."""
+    import textwrap
+
+    from gymfg_il import cli
+    from gymfg_il.cockpit.inputs.keys import keys_help
     from gymfg_il.web.config import WebConfig
 
     web = sub.add_parser(
         "web",
-        help="people fly from their browsers (a web cockpit on this machine; physics here), "
-        "every saved episode into one dataset",
+        help="people fly from their browsers; every saved episode goes to one dataset",
         description=textwrap.fill(
-            "Serve a web cockpit: each pilot opens the invite link printed for them and flies "
-            "in their browser (keyboard, mouse stick or gamepad) an aircraft simulated here "
-            "in real time; every step goes to OUT/logs and every saved episode to one "
-            "dataset in OUT/dataset. The keys are collect manual's. Ctrl-C stops the server "
-            "(an episode in flight is discarded; nothing saved is lost). Guide: "
-            "docs/guides/web.md.",
+            "Serve a web cockpit: each pilot opens their invite link and flies in a browser "
+            "(keyboard, mouse stick or gamepad) an aircraft simulated here in real time; every "
+            "saved episode goes to one dataset, OUT/dataset. Ctrl-C stops it. The keys are "
+            "collect manual's (below). Guide: docs/guides/web.md.",
             79,
         ),
         epilog=keys_help(),
@@ -146,12 +158,6 @@ def _flying(sub: Any) -> None:
         flags={"agent_hz": "--fps"},
     )
     cli.add_fields(web, WebConfig, only=MANUAL_ONLY, shown={"gusts": "none"})
-    dagger = sub.add_parser(
-        "dagger",
-        help="the policy flies, the controller labels what it visits, the data is aggregated "
-        "and the policy retrained",
-    )
-    cli.add_fields(dagger, DaggerConfig)
 
 
 def _tools(sub: Any) -> None:

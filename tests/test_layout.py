@@ -27,7 +27,7 @@ LAYERS = [
     {"datasets"},
     {"collectors"},
     {"cockpit"},
-    {"learning"},
+    {"learning", "web"},
     {"evaluation", "export", "rl"},
     {"cli", "collect", "train", "eval", "serve", "demo", "lerobot_env"},
 ]

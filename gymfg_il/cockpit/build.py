@@ -109,16 +109,12 @@ def build(
     check_out_folder(config.out)
     flight = config.flight()
     env = flight.make_env(list(config.view) or None)
-    images = list(config.images)
     check_appendable(
-        config.out, env.observation_names, flight.agent_hz, None, images, config.image_size
+        config.out, env.observation_names, flight.agent_hz, None, config.images, config.image_size
     )
     realtime = not synthetic if realtime is None else realtime
     draw = not synthetic if draw is None else draw
-    pilot_view = None if config.pilot_view == "none" else config.pilot_view
-    camera = None
-    if pilot_view and draw and plug is None:
-        camera = Camera(320, 320, view=pilot_view, legible=True)
+    camera = _camera(config, draw and plug is None)
     human = _controller(config, env, window_size(camera is not None))
     takeover = Takeover(human, _assistant(config.assist, flight, env))
     # DART noise on what the synthetic pilot flies (drawn from each episode's seed); the
@@ -126,47 +122,42 @@ def build(
     rollout = Rollout(env, [takeover], noise=config.noise)
     person = "synthetic" if synthetic else "human"
     assistant = _assistant_name(config.assist)
-    source = person if assistant is None else f"{assistant}+{person}"
-    record = session_record(
-        flight,
-        source,
-        device=human.device,
-        noise=config.noise,
-        images=images,
-        image_size=config.image_size,
-    )
-    log = _flight_log(config, env, flight, record, source, realtime, plug)
+    log = _flight_log(config, env, flight, human.device, person, assistant, realtime, plug)
     updater = DatasetUpdater(config.out) if plug is None else plug.updater
     stats = SessionStats()
     # a person's dataset follows each saved episode; the synthetic pilot's is built at the end
     phases = Phases(
         rollout, log, takeover, updater, stats, seed=config.seed, build_each=not synthetic
     )
-    window: Window = NoWindow()
     if plug is not None:
-        window = plug.window(human, env, flight)
-    elif draw:
-        window = _window(config, flight, env, camera, human, person, assistant)
-    source_of_input = (
-        plug.input(human, env)
-        if plug is not None
-        else _input(config, env, human, takeover.assistant is not None)
-    )
+        ends = (plug.input(human, env), plug.window(human, env, flight))
+    else:
+        window: Window = NoWindow()
+        if draw:
+            window = _window(config, flight, env, camera, human, person, assistant)
+        ends = (_input(config, env, human, takeover.assistant is not None), window)
     return Stages(
         env=env,
         human=human,
         takeover=takeover,
         pace=Pace(env.dt, realtime, spin=plug is None),
-        input=source_of_input,
+        input=ends[0],
         phases=phases,
         rollout=rollout,
         log=log,
         updater=updater,
-        window=window,
+        window=ends[1],
         stats=stats,
         out=config.out,
         episodes=config.episodes,
     )
+
+
+def _camera(config: ManualConfig, shown: bool) -> Camera | None:
+    """The pilot's view beside the instruments, in a window that is ``shown``, if asked for."""
+    if not shown or config.pilot_view == "none":
+        return None
+    return Camera(320, 320, view=config.pilot_view, legible=True)
 
 
 def _window(
@@ -259,12 +250,23 @@ def _flight_log(
     config: ManualConfig,
     env: AircraftEnv,
     flight: FlightSpec,
-    record: dict[str, Any],
-    source: str,
+    device: str,
+    person: str,
+    assistant: str | None,
     realtime: bool,
     plug: Plug | None,
 ) -> FlightLog:
-    """The session's log; the pilot named by the config (the synthetic pilot by its skill)."""
+    """The session's log; the pilot named by the config (the synthetic pilot by its skill),
+    the source ``person`` or ``ASSISTANT+person``."""
+    source = person if assistant is None else f"{assistant}+{person}"
+    record = session_record(
+        flight,
+        source,
+        device=device,
+        noise=config.noise,
+        images=list(config.images),
+        image_size=config.image_size,
+    )
     named = config.pilot_name
     if named is None:
         named = f"synthetic-{config.skill:g}" if config.pilot == "synthetic" else ""

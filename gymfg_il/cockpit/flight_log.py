@@ -25,6 +25,7 @@ from gymfg_il.sim.gusts import gust_records
 from gymfg_il.tasks.verdicts import EpisodeVerdict
 
 if TYPE_CHECKING:
+    from gymfg_il.cockpit.inputs.source import Remote
     from gymfg_il.sim.simulation import Simulation
 
 
@@ -99,13 +100,20 @@ class FlightLog:
         observation: np.ndarray,
         read_at: float,
         period: float | None,
-        delay: tuple[float, int] | None = None,
+        remote: Remote | None = None,
     ) -> str | None:
         """Log one flown step (``observation``: the pilot's next one; ``read_at``: the wall
         clock its input was read at; ``period``: the loop period that led to its frame;
-        ``delay``: an input from afar's round trip and age, ``inputs.source.Polled``); how
-        the episode ended if this step ended it, else None."""
-        self._writer().log_tick(tick, read_at if self.realtime else None)
+        ``remote``: an input from afar's arrival, round trip and age,
+        ``inputs.source.Remote``); how the episode ended if this step ended it, else None."""
+        afar = None
+        if self.realtime and remote is not None:
+            afar = {
+                "input_arrived_s": remote.arrived_s,
+                "input_delay_ms": 1000.0 * remote.trip_s,
+                "input_age_frames": remote.age_frames,
+            }
+        self._writer().log_tick(tick, read_at if self.realtime else None, afar)
         (step,) = tick.steps
         self.last_action = step.action
         assert self.verdict is not None  # start() came first
@@ -115,8 +123,8 @@ class FlightLog:
         self.interventions += int(step.intervention)
         if self.realtime and period is not None and self.timing.add(period):
             self._late_at = time.perf_counter()
-        if self.realtime and delay is not None:
-            self.timing.add_delay(delay)
+        if self.realtime and remote is not None:
+            self.timing.add_delay(remote.trip_s, remote.age_frames)
         if not tick.done:
             return None
         return step.reason or "terminated" if step.terminated else "time limit"

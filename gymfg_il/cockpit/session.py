@@ -118,7 +118,7 @@ class ManualSession:
         running = s.phases.apply(polled.commands)
         if running and s.phases.state == "recording":
             tick = s.rollout.step()
-            ended = s.log.log(tick, s.rollout.current[0], polled.read_at, period, polled.delay)
+            ended = s.log.log(tick, s.rollout.current[0], polled.read_at, period, polled.remote)
             if ended is not None:
                 s.phases.finish(ended)
         s.updater.poll()

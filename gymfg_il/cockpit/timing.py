@@ -40,10 +40,10 @@ class EpisodeTiming:
         self.late += late
         return late
 
-    def add_delay(self, delay: tuple[float, int]) -> None:
+    def add_delay(self, trip_s: float, age_frames: int) -> None:
         """Count the round trip (s) and age (frames) of the input a frame flew by."""
-        self.delays.append(delay[0])
-        self.ages.append(delay[1])
+        self.delays.append(trip_s)
+        self.ages.append(age_frames)
 
     def record(self) -> dict[str, float | int]:
         """The episode's timing as its end event stores it: late frames, the rate achieved

@@ -226,6 +226,7 @@ def facts(meta: Any, episodes: dict[str, list[Any]], specs: list[Any]) -> list[t
         ("grades", _grades(episodes.get("gymfg/grade", []))),
         ("timing", _timing(episodes)),
         ("pilots", _pilots(episodes)),
+        ("devices", counted(episodes.get("gymfg/device", [])).replace("unknown", "none")),
         ("pilots' marks", counted(episodes.get("gymfg/mark", [])).replace("unknown", "none")),
         ("rates", f"{meta.fps} fps (agent steps); JSBSim at {sim_hz} Hz"),
         ("episodes", f"{meta.total_episodes} ({meta.total_frames} frames)"),

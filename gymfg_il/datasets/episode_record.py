@@ -58,9 +58,10 @@ def target_record(task: dict[str, Any], target: float | None) -> dict[str, Any]:
 def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[str, Any]:
     """The ``gymfg/*`` columns of one aircraft's episode: where it comes from and what was
     flown (``spec``: the flight spec, JSON; ``target``: ``target_record``), who flew it and
-    how it went (``pilot``; ``success``: the task's verdict, 1 or 0, -1 where it was not
-    judged, with ``verdict`` in words; ``grade``: the task's (``tasks.grades``), or "";
-    ``mark``: the pilot's own, or ""; ``gusts``: those blown, in a gusty flight)."""
+    how it went (``pilot``, ``device``: the device they flew with, or ""; ``success``: the
+    task's verdict, 1 or 0, -1 where it was not judged, with ``verdict`` in words;
+    ``grade``: the task's (``tasks.grades``), or ""; ``mark``: the pilot's own, or "";
+    ``gusts``: those blown, in a gusty flight)."""
     start, end = episode.start, episode.end or {}
     target = episode.start_of(callsign).get("target")
     info = log.aircraft(callsign)
@@ -78,6 +79,7 @@ def episode_metadata(log: Log, episode: LoggedEpisode, callsign: str) -> dict[st
         "iteration": int(start.get("iteration", 0)),
         "outcome": str(end.get("outcome", "")),
         "pilot": _text(start.get("pilot")),
+        "device": _text(log.session.get("device")),
         "success": _verdict(end.get("success")),
         "verdict": _text(end.get("verdict")),
         "grade": str(end["grade"]) if rank(end.get("grade")) >= 0 else "",

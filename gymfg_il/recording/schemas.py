@@ -71,6 +71,20 @@ STEP = {
             "type": "number",
             "description": "real time only: the wall clock (Unix s) when the input was read",
         },
+        "input_arrived_s": {
+            "type": "number",
+            "description": "from afar (collect web): the wall clock (Unix s) when the input "
+            "flown arrived",
+        },
+        "input_delay_ms": {
+            "type": "number",
+            "description": "from afar: that input's round trip, from the frame it answered "
+            "being sent to its arrival",
+        },
+        "input_age_frames": {
+            "type": "integer",
+            "description": "from afar: frames between the frame it answered and this step",
+        },
     },
     "required": ["episode", "step", "observation", "action", "label", "reward"],
 }

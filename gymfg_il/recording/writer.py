@@ -227,14 +227,17 @@ class TrajectoryWriter:
         self._emit(self._tfs[callsign], message)
         return where, velocity
 
-    def log_tick(self, tick: Tick, wall_time_s: float | None = None) -> None:
+    def log_tick(
+        self, tick: Tick, wall_time_s: float | None = None, afar: dict[str, Any] | None = None
+    ) -> None:
         """Log one agent step of the flight: every aircraft's step and each team's view
-        (``wall_time_s``: in a session flown in real time, when its input was read)."""
+        (``wall_time_s``: in a session flown in real time, when its input was read;
+        ``afar``: the step's ``input_*`` fields, for an input from afar, ``collect web``)."""
         self._at_step(tick.step)
         for s in tick.steps:
             self.log_step(
                 s.callsign, s.step, s.state, s.observation, s.action, s.label, s.reward,
-                s.terminated, s.truncated, s.intervention, wall_time_s,
+                s.terminated, s.truncated, s.intervention, wall_time_s, afar,
             )  # fmt: skip
         for team, view in tick.views.items():
             self.log_view(team, tick.step, view)
@@ -278,11 +281,15 @@ class TrajectoryWriter:
         truncated: bool = False,
         intervention: bool = False,
         wall_time_s: float | None = None,
+        afar: dict[str, Any] | None = None,
     ) -> None:
         """Log one agent step of ``callsign`` (state after the step, action that led to it;
-        ``wall_time_s`` only in real time: the wall clock when the input was read)."""
+        ``wall_time_s`` only in real time: the wall clock when the input was read; ``afar``:
+        the ``input_*`` fields of an input from afar)."""
         values = state.tolist()
         clock = {} if wall_time_s is None else {"wall_time_s": float(wall_time_s)}
+        if afar:
+            clock |= afar
         self._emit(
             self._steps[callsign],
             {

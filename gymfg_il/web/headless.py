@@ -96,6 +96,39 @@ def wire(events: list[Any]) -> list[list[Any]]:
 SPACE = [["down", "space"], ["up", "space"]]
 
 
+class _Answers:
+    """The headless pilot's answer to each frame (module docstring)."""
+
+    def __init__(self, episodes: int, skill: float) -> None:
+        self.episodes, self.skill = episodes, skill
+        self.pilot: Any = None
+        self.env: Any = None
+        self.started = 0
+
+    def welcome(self, message: dict[str, Any]) -> None:
+        self.pilot, self.env = _pilot(message, self.skill)
+
+    def events(self, message: dict[str, Any]) -> list[list[Any]] | None:
+        """This frame's events; None once the episodes asked for are saved."""
+        status, pilot = message["status"], self.pilot
+        if status == "idle":
+            return None if message["episode"] >= self.episodes else SPACE
+        if status != "recording":
+            return []
+        if message["started"] != self.started:  # a new episode: its own seed
+            self.started = message["started"]
+            pilot.reset(message["seed"])
+            pilot.start_from(np.array(message["start"]))
+        if not message["human"]:
+            return []
+        display = Display(tuple(Reading(*r) for r in message["readings"]))
+        return wire(pilot.events(display, np.array(message["controls"])))
+
+    def close(self) -> None:
+        if self.env is not None:
+            self.env.close()
+
+
 async def fly(
     url: str, invite: str, episodes: int, *, skill: float = 0.7, device: str = "keyboard"
 ) -> Flown:
@@ -104,9 +137,7 @@ async def fly(
     from websockets.asyncio.client import connect
     from websockets.exceptions import ConnectionClosed
 
-    flown = Flown()
-    pilot = env = None
-    started, seq = 0, 0
+    flown, answers, seq = Flown(), _Answers(episodes, skill), 0
     try:
         async with connect(url, max_size=2**22, open_timeout=30) as ws:
             await ws.send(orjson.dumps({"type": "hello", "invite": invite, "device": device}))
@@ -115,48 +146,26 @@ async def fly(
                     message = orjson.loads(data)
                     if message.get("type") == "welcome":
                         flown.welcome = message
-                        pilot, env = _pilot(message, skill)
+                        answers.welcome(message)
                         continue
-                    if message.get("type") != "frame" or pilot is None:
+                    if message.get("type") != "frame" or answers.pilot is None:
                         continue
                     flown.frames += 1
                     flown.saved = message["episode"]
-                    events: list[list[Any]] = []
-                    status = message["status"]
-                    if status == "idle":
-                        if flown.saved >= episodes:
-                            break
-                        events = SPACE
-                    elif status == "recording":
-                        if message["started"] != started:  # a new episode: its own seed
-                            started = message["started"]
-                            pilot.reset(message["seed"])
-                            pilot.start_from(np.array(message["start"]))
-                        if message["human"]:
-                            display = Display(tuple(Reading(*r) for r in message["readings"]))
-                            made = pilot.events(display, np.array(message["controls"]))
-                            events = wire(made)
+                    events = answers.events(message)
+                    if events is None:
+                        break
                     seq += 1
                     flown.inputs += 1
-                    await ws.send(
-                        orjson.dumps(
-                            {
-                                "type": "input",
-                                "seq": seq,
-                                "at": time.monotonic() * 1000.0,
-                                "frame": message["n"],
-                                "events": events,
-                            }
-                        )
-                    )
+                    answer = {"type": "input", "seq": seq, "at": time.monotonic() * 1000.0,
+                              "frame": message["n"], "events": events}  # fmt: skip
+                    await ws.send(orjson.dumps(answer))
             except ConnectionClosed as closed:
                 flown.closed = closed.rcvd.reason if closed.rcvd is not None else "dropped"
             else:
-                if ws.close_reason:
-                    flown.closed = ws.close_reason
+                flown.closed = ws.close_reason or ""
     finally:
-        if env is not None:
-            env.close()
+        answers.close()
     return flown
 
 

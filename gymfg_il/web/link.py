@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from gymfg_il.cockpit.inputs.keys import COMMAND_KEYS, help_lines
-from gymfg_il.cockpit.inputs.source import Polled, Seen
+from gymfg_il.cockpit.inputs.source import Polled, Remote, Seen
 from gymfg_il.cockpit.windows.view import CockpitView
 from gymfg_il.display.briefing import briefing
 from gymfg_il.envs.flight import FlightSpec
@@ -123,7 +123,8 @@ class WebInput:
 
         self.link, self.human, self.dt, self.pg = link, human, dt, pygame
         self.codes = key_codes()  # every name web.protocol.KEYS allows is here (a test says)
-        self._newest: tuple[int, float] | None = None  # (frame answered, round trip s)
+        # the newest input: (the frame it answered, its round trip s, its arrival, Unix s)
+        self._newest: tuple[int, float, float] | None = None
 
     def poll(self, seen: Seen) -> Polled:
         pg, link = self.pg, self.link
@@ -132,8 +133,9 @@ class WebInput:
         for message, arrived in link.take():
             events += self._events(message)
             sent = link.sent_at.get(message.frame)
-            if sent is not None:
-                self._newest = (message.frame, arrived - sent)
+            if sent is not None:  # (perf_counter: the round trip; the wall clock: the log's)
+                wall = time.time() - (time.perf_counter() - arrived)
+                self._newest = (message.frame, arrived - sent, wall)
         read_at = time.time()
         if link.dropped or link.quit or link.stop:
             link.dropped = False
@@ -162,11 +164,11 @@ class WebInput:
                     commands.append(command)
         if link.stop:
             commands.append("quit")
-        delay = None
+        remote = None
         if self._newest is not None:
-            frame, trip = self._newest
-            delay = (trip, link.frame - frame)
-        return Polled(commands, read_at, delay)
+            frame, trip, wall = self._newest
+            remote = Remote(wall, trip, link.frame - frame)
+        return Polled(commands, read_at, remote)
 
     def _events(self, message: Input) -> list[Any]:
         """The pygame events of one input message (checked by ``web.protocol``)."""

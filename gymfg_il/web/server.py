@@ -23,23 +23,20 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
-import re
 import sys
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from importlib import resources
 from typing import Any
 
-from gymfg_il.cockpit.build import Plug
-from gymfg_il.cockpit.updater import DatasetUpdater
 from gymfg_il.collectors.session import check_appendable, check_out_folder
 from gymfg_il.envs.options import FlightOptions
 from gymfg_il.errors import ConfigError
 from gymfg_il.web.config import WebConfig
-from gymfg_il.web.invites import Invite, find, invites, names_from
-from gymfg_il.web.link import PilotLink, WebInput, WebWindow
+from gymfg_il.web.invites import find, invites, names_from
+from gymfg_il.web.link import PilotLink
+from gymfg_il.web.pilots import Pilot, Pilots
 from gymfg_il.web.protocol import (
     HELLO_S,
     MAX_MESSAGE_BYTES,
@@ -54,57 +51,6 @@ log = logging.getLogger(__name__)
 
 SOCKETS_PER_PILOT = 4  # open sockets allowed (flying or not yet) per pilot slot
 NEEDS = "the web cockpit needs its extra: pip install -e '.[web]' (starlette, uvicorn, websockets)"
-
-
-class SharedUpdater(DatasetUpdater):
-    """One dataset updater for every pilot's session (``cockpit.updater``: one helper process
-    writes the dataset). A session's end leaves it running; ``shutdown`` finishes it."""
-
-    def __init__(self, out: Any) -> None:
-        super().__init__(out)
-        self.lock = threading.RLock()
-
-    def warm(self) -> None:
-        with self.lock:
-            super().warm()
-
-    def request(self) -> None:
-        with self.lock:
-            super().request()
-
-    def poll(self) -> None:
-        if self.lock.acquire(blocking=False):  # another pilot's loop is polling: skip
-            try:
-                super().poll()
-            finally:
-                self.lock.release()
-
-    def close(self) -> bool:
-        """A pilot's session ended: the dataset goes on serving the others."""
-        return self.built
-
-    def shutdown(self) -> bool:
-        """Finish every outstanding build and stop the helper; True if a dataset was built."""
-        with self.lock:
-            return super().close()
-
-
-@dataclass
-class Pilot:
-    """One invite's pilot: their session (a thread), its link, the socket flying it."""
-
-    invite: Invite
-    next_seed: int
-    link: PilotLink | None = None
-    thread: threading.Thread | None = None
-    device: str | None = None
-    socket: Any = None
-    saved: int = 0
-
-
-def _file_name(name: str) -> str:
-    """A pilot's name as part of a log file's name."""
-    return re.sub(r"[^A-Za-z0-9_.-]", "_", name)[:40] or "pilot"
 
 
 class WebServer:
@@ -139,11 +85,9 @@ class WebServer:
             else [f"pilot-{k + 1}" for k in range(config.pilots)]
         )
         self.invites = invites(config.out, names, config.seed)
-        self.pilots = {i.name: Pilot(i, i.seed) for i in self.invites}
-        self.updater = SharedUpdater(config.out)
+        self.pilots = Pilots(config, self.invites, self.flight_options, self.say)
         self.sockets = 0
         self.port = config.port
-        self.lock = threading.Lock()
         self.serving = threading.Event()
         self._uvicorn: Any = None
 
@@ -197,7 +141,7 @@ class WebServer:
     # -- a pilot's socket -----------------------------------------------------------------
     async def socket(self, websocket: Any) -> None:
         """One page's websocket, from hello to close (module docstring)."""
-        limit = SOCKETS_PER_PILOT * len(self.pilots)
+        limit = SOCKETS_PER_PILOT * len(self.invites)
         if self.sockets >= limit:
             await websocket.close(code=1013)  # refused before it is accepted
             return
@@ -247,17 +191,17 @@ class WebServer:
         invite = find(self.invites, said.invite)
         if invite is None:
             raise ProtocolError("no such invite")
-        pilot = self.pilots[invite.name]
+        pilot = self.pilots.by_name[invite.name]
         if self.config.episodes and pilot.saved >= self.config.episodes:
             raise ProtocolError(f"you have saved your {pilot.saved} episode(s); thank you")
-        flying = sum(p.socket is not None and p is not pilot for p in self.pilots.values())
+        flying = sum(p.socket is not None and p is not pilot for p in self.pilots.by_name.values())
         if flying >= self.config.pilots:
             raise ProtocolError(f"the server is full ({self.config.pilots} pilots); try later")
         if pilot.socket is not None:  # the newest page flies
             old, pilot.socket = pilot.socket, None
             await self._close(old, 1008, "this invite was opened again elsewhere", pilot)
         pilot.socket = websocket
-        await asyncio.to_thread(self._session, pilot, said.device)
+        await asyncio.to_thread(self.pilots.start, pilot, said.device)
         assert pilot.link is not None
         if pilot.link.failed is not None:
             raise ProtocolError(f"the session could not start: {pilot.link.failed}")
@@ -312,62 +256,6 @@ class WebServer:
                 await websocket.close(code=1000, reason=link.close_reason[:120])
                 return
 
-    # -- a pilot's session ----------------------------------------------------------------
-    def _session(self, pilot: Pilot, device: str) -> None:
-        """Start the pilot's session (or keep it: the same device), and wait until it flies."""
-        with self.lock:
-            if pilot.thread is not None and pilot.thread.is_alive():
-                if pilot.device == device:
-                    return
-                assert pilot.link is not None
-                pilot.link.stop = True  # another device: a new session, the next seed on
-                pilot.thread.join()
-            link = PilotLink(pilot.invite.name, self.say)
-            pilot.link, pilot.device = link, device
-            pilot.thread = threading.Thread(
-                target=self._run, args=(pilot, link, device), name=f"pilot-{pilot.invite.name}"
-            )
-            pilot.thread.daemon = True
-            pilot.thread.start()
-        link.ready.wait(60)
-        if not link.ready.is_set():
-            link.failed = "it did not start within 60 s"
-
-    def _run(self, pilot: Pilot, link: PilotLink, device: str) -> None:
-        from gymfg_il.cockpit.session import ManualSession
-
-        config = self.config.pilot_session(pilot.invite.name, pilot.next_seed, device)
-        options = self.flight_options
-        say = self.say
-
-        def window(human: Any, env: Any, flight: Any) -> WebWindow:
-            return WebWindow(link, human, env, flight, options, say)
-
-        plug = Plug(
-            input=lambda human, env: WebInput(link, human, env.dt),
-            window=window,
-            updater=self.updater,
-            log_tag=f"web-{_file_name(pilot.invite.name)}",
-        )
-        try:
-            session = ManualSession(config, plug=plug, realtime=True, draw=True)
-            # a first reset builds and trims what later ones reuse (tens of ms): done now, not
-            # in a frame while other pilots fly (a reset is seeded: the flight is the same)
-            session.stages.env.reset(seed=config.seed)
-        except Exception as err:  # said to the page, and here
-            link.failed = f"{type(err).__name__}: {err}"
-            log.exception("pilot %s: the session did not start", pilot.invite.name)
-            link.ready.set()
-            return
-        link.ready.set()
-        try:
-            stats = session.run()
-        finally:
-            pilot.next_seed = session.stages.phases.next_seed
-        pilot.saved += stats.saved
-        if not link.stop:  # the pilot saved every episode asked for
-            link.close_page(f"thank you: you saved your {pilot.saved} episode(s)")
-
     # -- serving --------------------------------------------------------------------------
     def run(self) -> int:
         """Serve until interrupted (Ctrl-C or SIGTERM), then finish the dataset."""
@@ -410,7 +298,7 @@ class WebServer:
     async def _serve(self, server: Any) -> None:
         # the dataset's helper starts now, not as the first pilot's first episode starts (a
         # fork then would hold up that pilot's frames)
-        await asyncio.to_thread(self.updater.warm)
+        await asyncio.to_thread(self.pilots.updater.warm)
         task = asyncio.create_task(server.serve())
         while not server.started and not task.done():
             await asyncio.sleep(0.02)
@@ -438,14 +326,7 @@ class WebServer:
     def close(self) -> None:
         """End every pilot's session (an episode in flight is discarded) and finish the
         dataset."""
-        for pilot in self.pilots.values():
-            if pilot.link is not None:
-                pilot.link.stop = True
-        for pilot in self.pilots.values():
-            if pilot.thread is not None:
-                pilot.thread.join(timeout=30)
-        built = self.updater.shutdown()
-        saved = sum(p.saved for p in self.pilots.values())
+        saved, built = self.pilots.close()
         where = f"{self.config.out}/dataset" if built else "none built"
-        self.say(f"saved {saved} episode(s) from {len(self.pilots)} invite(s); dataset: {where}")
+        self.say(f"saved {saved} episode(s) from {len(self.invites)} invite(s); dataset: {where}")
         sys.stdout.flush()

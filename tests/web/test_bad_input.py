@@ -11,7 +11,7 @@ import pytest
 
 from gymfg_il.web.headless import fly
 
-pytestmark = pytest.mark.network
+pytestmark = [pytest.mark.network, pytest.mark.slow]
 
 
 def _input(**fields):

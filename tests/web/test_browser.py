@@ -73,6 +73,7 @@ def test_keys_pressed_in_chromium_are_the_actions_in_the_log(serve, tmp_path):
     assert served.stop() == 0
 
 
+@pytest.mark.slow
 def test_an_emulated_gamepad_flies_after_its_calibration(serve):
     served = serve("--episode-time", "3", "--pilots", "1")
     errors: list[str] = []

@@ -53,6 +53,18 @@ def test_the_web_pilot_records_what_the_synthetic_pilot_records_at_this_machine(
         assert end["late_frames"] == 0 and 29.0 < end["rate_hz"] < 31.0
         assert end["input_age_frames"] >= 1 and end["input_delay_ms"] > 0
 
+    # each step's record says when the input it flew arrived, and how old it was
+    from mcap.reader import make_reader
+
+    with (served.out / "logs").glob("*.mcap").__next__().open("rb") as f:
+        steps = [
+            orjson.loads(m.data)
+            for _, c, m in make_reader(f).iter_messages()
+            if c.topic.endswith("/step")
+        ]
+    assert len(steps) == 240 and {s["input_age_frames"] for s in steps} == {1}
+    assert all(0 < s["wall_time_s"] - s["input_arrived_s"] < 1 / 30 for s in steps)
+
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     data = LeRobotDataset("local/web", root=served.out / "dataset")
@@ -61,6 +73,7 @@ def test_the_web_pilot_records_what_the_synthetic_pilot_records_at_this_machine(
     assert all(d > 0 for d in episodes["gymfg/input_delay_ms"])
     card = (served.out / "dataset" / "README.md").read_text()
     assert "input delay p99" in card and "pilot-2" in card
+    assert "keyboard (2 episodes)" in card  # the device each episode was flown with
 
 
 def test_a_dropped_page_loses_its_episode_in_flight_and_the_same_invite_flies_it_again(serve):

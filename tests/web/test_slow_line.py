@@ -14,7 +14,7 @@ import pytest
 
 from gymfg_il.web.headless import fly
 
-pytestmark = pytest.mark.network
+pytestmark = [pytest.mark.network, pytest.mark.slow]
 
 ONE_WAY_S = 0.05  # each way: 100 ms added to the round trip
 LOSS = 0.05

@@ -45,13 +45,23 @@ class Polled:
     """One frame's input: the session commands read (in order) and the wall clock at which the
     input was read (what a real-time session records with the frame).
 
-    ``delay``: for an input from afar (``collect web``), the newest input's round trip (s,
-    from sending the frame it answered to its arrival) and its age in frames (this frame's
-    number less the answered one's); None for a local input."""
+    ``remote``: for an input from afar (``collect web``), when the newest input arrived,
+    its round trip and its age (``Remote``); None for a local input."""
 
     commands: list[str]
     read_at: float
-    delay: tuple[float, int] | None = None
+    remote: Remote | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Remote:
+    """The input a frame flies by, from afar: the wall clock (Unix s) it arrived at, its
+    round trip (s, from sending the frame it answered to its arrival) and its age in frames
+    (this frame's number less the answered one's; 1: the next frame)."""
+
+    arrived_s: float
+    trip_s: float
+    age_frames: int
 
 
 class Input(Protocol):
