@@ -9,6 +9,9 @@
 #   gui.png  the controls GUI in flight (python -m gymfg_il.cockpit.screenshot)
 #   window_approach.png, window_formation.png  the window 20 s into the approach and the
 #       formation, flown by the synthetic pilot from what the window shows (screenshot --task)
+#   web_approach.png, web_formation.png  the web cockpit in Chromium 8 s into the approach and
+#       the formation, hands off (web_screenshot.py; needs Chromium; real time, so it differs a
+#       little from run to run)
 #   flightgear.png  only with FLIGHTGEAR=1: FlightGear fed by JSBSim, from its test (needs fgfs
 #       and Xvfb; a real-time screenshot, so it differs from run to run)
 # Everything but the FlightGear picture is flown from fixed seeds, so the same code makes the
@@ -39,6 +42,11 @@ python -m gymfg_il.cockpit.screenshot "$OUT/gui.png"
 for TASK in approach formation; do
   python -m gymfg_il.cockpit.screenshot "$OUT/window_$TASK.png" --task "$TASK"
 done
+if command -v chromium >/dev/null; then
+  for TASK in approach formation; do
+    python docs/experiments/web_screenshot.py "$OUT/web_$TASK.png" --task "$TASK"
+  done
+fi
 if [ "${FLIGHTGEAR:-0}" = 1 ]; then
   GYMFG_SCREENSHOT="$(realpath "$OUT")/flightgear.png" python -m pytest -q -m flightgear \
     tests/flightgear/test_flightgear.py::test_flightgear_follows_jsbsim

@@ -106,3 +106,38 @@ def test_an_emulated_gamepad_flies_after_its_calibration(serve):
     assert np.allclose(elevator[:10], start)  # the resting offset is calibrated away
     assert elevator.max() > start + 0.4  # the push reached the surface
     assert served.stop() == 0
+
+
+@pytest.mark.slow
+def test_the_mouse_stick_follows_the_pointer_over_the_attitude_indicator(serve):
+    served = serve("--episode-time", "3", "--pilots", "1")
+    errors: list[str] = []
+    with playwright.sync_playwright() as p:
+        browser = _browser(p)
+        page = _open(browser, served, errors)
+        page.goto(f"{served.base}/fly")
+        page.select_option("#device", "mouse")
+        page.goto(f"{served.base}/fly#invite={served.invites['pilot-1']}")
+        page.reload()
+        page.select_option("#device", "mouse")
+        page.click("#join")
+        page.wait_for_function("document.getElementById('state').textContent.includes('mouse')")
+        box = page.locator("#cockpit").bounding_box()
+        scale = box["width"] / 1200
+
+        def at(dx: float) -> tuple[float, float]:  # canvas px right of the indicator's centre
+            return box["x"] + (420 + dx) * scale, box["y"] + 250 * scale
+
+        page.mouse.move(*at(0))
+        page.keyboard.press("Space")
+        page.wait_for_timeout(700)
+        page.mouse.move(*at(75), steps=5)  # half the stick's travel to the right
+        page.wait_for_timeout(700)
+        page.mouse.move(*at(-150), steps=5)  # full left
+        served.wait_for(r"pilot pilot-1 saved episode 1", timeout=30)
+        browser.close()
+    assert not errors, errors
+    (episode,) = _episodes(served.out)
+    aileron = episode.steps["ego"].action[:, 0]
+    assert aileron.max() > 0.4 and aileron.min() < -0.9
+    assert served.stop() == 0

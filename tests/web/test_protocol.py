@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import stat
 
 import pytest
@@ -87,3 +88,15 @@ def test_a_bad_invites_file_is_refused_with_what_is_wrong(tmp_path, text, said):
     path.write_text(text)
     with pytest.raises(ConfigError, match=said):
         names_from(path)
+
+
+@pytest.mark.parametrize(
+    "field, value, said",
+    [("pilots", 0, "pilots=0"), ("port", 70000, "port=70000"), ("host", "", "host=''"),
+     ("noise", 0.1, "not perturbed")],
+)  # fmt: skip
+def test_a_web_config_names_what_is_wrong_and_the_fix(tmp_path, field, value, said):
+    from gymfg_il.web.config import WebConfig
+
+    with pytest.raises(ConfigError, match=re.escape(said)):
+        WebConfig(out=tmp_path, **{field: value})

@@ -183,3 +183,10 @@ def test_kill_9_of_the_server_loses_no_saved_episode(serve):
     data = LeRobotDataset("local/web", root=served.out / "dataset")
     assert data.num_episodes == 4
     assert sorted(data.meta.episodes["gymfg/pilot"]) == ["pilot-1"] * 2 + ["pilot-2"] * 2
+
+
+def test_serving_beyond_this_machine_says_so_and_how_to_do_it_safely(serve):
+    served = serve("--pilots", "1", "--host", "0.0.0.0")
+    warning = served.wait_for(r"^WARNING: serving on 0\.0\.0\.0")
+    assert "TLS proxy" in warning and "docs/guides/web.md" in warning
+    assert served.stop() == 0
