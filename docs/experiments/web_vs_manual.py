@@ -53,8 +53,10 @@ def web(out: Path, task: str, seed: int, shares: list[int]) -> None:
         if "waiting for pilots" in line:
             break
 
-    async def everyone() -> list:
-        return await asyncio.gather(*(fly(url, t, n) for t, n in zip(tokens, shares, strict=True)))
+    async def everyone() -> list:  # (fly_many, with each pilot's own share of episodes)
+        ready = asyncio.Barrier(len(tokens))
+        flights = (fly(url, t, n, ready=ready) for t, n in zip(tokens, shares, strict=True))
+        return await asyncio.gather(*flights)
 
     try:
         flown = asyncio.run(everyone())
@@ -102,7 +104,6 @@ def main() -> int:
     manual(args.out / "manual", args.task, args.seed, shares)
     same, total = twins(args.out / "web", args.out / "manual")
     print(f"web episodes equal to their manual twins, step for step: {same} of {total}")
-    report = {}
     for name in ("web", "manual"):
         run("-m", "gymfg_il.train", "bc", "--dataset", str(args.out / name / "dataset"),
             "--out", str(args.out / f"{name}-bc"), "--no-progress")  # fmt: skip
@@ -111,8 +112,15 @@ def main() -> int:
               "--seed", str(args.eval_seed), "--json", str(args.out / "eval.json"),
               "--no-progress")  # fmt: skip
     print(out)
-    report = json.loads((args.out / "eval.json").read_text())
-    print(json.dumps(report, indent=1)[:2000])
+    rows = json.loads((args.out / "eval.json").read_text())["rows"]
+    by = {r["agent"]: {e["seed"]: e["total_return"] for e in r["per_episode"]} for r in rows}
+    w, m = by["policy:web-bc"], by["policy:manual-bc"]
+    per_seed = [w[s] / m[s] for s in w]
+    ratio = sum(w.values()) / sum(m.values())
+    print(
+        f"BC from web / BC from manual demonstrations: return {ratio:.4f} "
+        f"(per seed {min(per_seed):.4f} .. {max(per_seed):.4f})"
+    )
     return 0
 
 

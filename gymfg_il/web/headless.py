@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -130,10 +131,18 @@ class _Answers:
 
 
 async def fly(
-    url: str, invite: str, episodes: int, *, skill: float = 0.7, device: str = "keyboard"
+    url: str,
+    invite: str,
+    episodes: int,
+    *,
+    skill: float = 0.7,
+    device: str = "keyboard",
+    ready: asyncio.Barrier | None = None,
 ) -> Flown:
     """Fly ``episodes`` episodes through the web cockpit at ``url`` (its ``/ws``) with
-    ``invite``; returns what was done once the last is saved or the server closes."""
+    ``invite``; returns what was done once the last is saved or the server closes. With
+    ``ready``, wait there once set up, before the first answer (pilots sharing one process
+    start together: none is still setting up, holding the others' answers up)."""
     from websockets.asyncio.client import connect
     from websockets.exceptions import ConnectionClosed
 
@@ -147,6 +156,10 @@ async def fly(
                     if message.get("type") == "welcome":
                         flown.welcome = message
                         answers.welcome(message)
+                        if ready is not None:
+                            with contextlib.suppress(asyncio.BrokenBarrierError):
+                                await ready.wait()
+                            ready = None
                         continue
                     if message.get("type") != "frame" or answers.pilot is None:
                         continue
@@ -165,13 +178,17 @@ async def fly(
             else:
                 flown.closed = ws.close_reason or ""
     finally:
+        if ready is not None:  # never welcomed: the others start without this one
+            await ready.abort()
         answers.close()
     return flown
 
 
 async def fly_many(url: str, invites: list[str], episodes: int, **kwargs: Any) -> list[Flown]:
-    """Several headless pilots at once, one invite each."""
-    return list(await asyncio.gather(*(fly(url, i, episodes, **kwargs) for i in invites)))
+    """Several headless pilots at once, one invite each, starting together."""
+    ready = asyncio.Barrier(len(invites))
+    flights = (fly(url, i, episodes, ready=ready, **kwargs) for i in invites)
+    return list(await asyncio.gather(*flights))
 
 
 def main(argv: list[str] | None = None) -> int:
