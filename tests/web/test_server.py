@@ -63,7 +63,8 @@ def test_the_web_pilot_records_what_the_synthetic_pilot_records_at_this_machine(
             if c.topic.endswith("/step")
         ]
     assert len(steps) == 240 and {s["input_age_frames"] for s in steps} == {1}
-    assert all(0 < s["wall_time_s"] - s["input_arrived_s"] < 1 / 30 for s in steps)
+    # (arrived before the frame that read it; within about a period, a late frame's more)
+    assert all(0 < s["wall_time_s"] - s["input_arrived_s"] < 0.1 for s in steps)
 
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
