@@ -42,6 +42,15 @@ def _open(browser, served, errors):
     return page
 
 
+def _fly_with(page, served, device: str) -> None:
+    """Open the invite, choose ``device`` and fly (the page first joins with the keyboard)."""
+    page.goto(f"{served.base}/fly#invite={served.invites['pilot-1']}")
+    page.reload()
+    page.select_option("#device", device)
+    page.click("#join")
+    page.wait_for_function(f"document.getElementById('state').textContent.includes('{device}')")
+
+
 def test_keys_pressed_in_chromium_are_the_actions_in_the_log(serve, tmp_path):
     served = serve("--episode-time", "4", "--pilots", "1", "--task", "approach")
     errors: list[str] = []
@@ -84,11 +93,7 @@ def test_an_emulated_gamepad_flies_after_its_calibration(serve):
         page.goto(f"{served.base}/fly")  # no invite in the link: it says so, and waits
         assert "no invite" in page.evaluate("document.getElementById('state').textContent")
         page.evaluate("window.__pad.axes[1] = 0.1")  # a stick that rests off centre
-        page.goto(f"{served.base}/fly#invite={served.invites['pilot-1']}")
-        page.reload()
-        page.select_option("#device", "joystick")
-        page.click("#join")
-        page.wait_for_function("document.getElementById('state').textContent.includes('joystick')")
+        _fly_with(page, served, "joystick")
         page.evaluate("window.__pad.axes[1] = 0.1")  # at rest: calibrated away
         page.keyboard.press("c")
         page.keyboard.press("Space")
@@ -115,13 +120,7 @@ def test_the_mouse_stick_follows_the_pointer_over_the_attitude_indicator(serve):
     with playwright.sync_playwright() as p:
         browser = _browser(p)
         page = _open(browser, served, errors)
-        page.goto(f"{served.base}/fly")
-        page.select_option("#device", "mouse")
-        page.goto(f"{served.base}/fly#invite={served.invites['pilot-1']}")
-        page.reload()
-        page.select_option("#device", "mouse")
-        page.click("#join")
-        page.wait_for_function("document.getElementById('state').textContent.includes('mouse')")
+        _fly_with(page, served, "mouse")
         box = page.locator("#cockpit").bounding_box()
         scale = box["width"] / 1200
 
