@@ -51,6 +51,28 @@ def _fly_with(page, served, device: str) -> None:
     page.wait_for_function(f"document.getElementById('state').textContent.includes('{device}')")
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("task", ["formation", "waypoints", "turn"])
+def test_the_page_draws_every_reading_of_the_display_model(serve, task):
+    """As the pygame window does (tests/display): each task's every reading, bugs, needles,
+    the slot and the guidance, is on the page (the approach's: the keys test below)."""
+    served = serve("--episode-time", "5", "--pilots", "1", "--task", task)
+    errors: list[str] = []
+    with playwright.sync_playwright() as p:
+        browser = _browser(p)
+        page = _open(browser, served, errors)
+        page.goto(f"{served.base}/fly#invite={served.invites['pilot-1']}")
+        page.wait_for_function("document.getElementById('state').textContent.startsWith('flying')")
+        page.keyboard.press("Space")
+        page.wait_for_function("window.__frame && window.__frame.status === 'recording'")
+        page.wait_for_timeout(500)
+        drawn, frame = page.evaluate("[window.__drawn, window.__frame]")
+        browser.close()
+    assert not errors, errors
+    assert set(drawn) == {r[0] for r in frame["readings"]}
+    assert served.stop() == 0
+
+
 def test_keys_pressed_in_chromium_are_the_actions_in_the_log(serve, tmp_path):
     served = serve("--episode-time", "4", "--pilots", "1", "--task", "approach")
     errors: list[str] = []
@@ -67,6 +89,7 @@ def test_keys_pressed_in_chromium_are_the_actions_in_the_log(serve, tmp_path):
         page.keyboard.down("ArrowDown")  # pull: the elevator goes nose up (negative)
         page.wait_for_timeout(700)
         page.screenshot(path=str(tmp_path / "approach.png"))
+        drawn, frame = page.evaluate("[window.__drawn, window.__frame]")
         page.keyboard.up("ArrowDown")
         served.wait_for(r"pilot pilot-1 saved episode 1", timeout=30)
         page.wait_for_timeout(300)
@@ -74,6 +97,8 @@ def test_keys_pressed_in_chromium_are_the_actions_in_the_log(serve, tmp_path):
         browser.close()
     assert not errors, errors
     assert text.startswith("flying as pilot-1")
+    names = {r[0] for r in frame["readings"]}
+    assert set(drawn) == names and "glideslope_dots" in names  # the ILS and all the rest
     (episode,) = _episodes(served.out)
     elevator = episode.steps["ego"].action[:, 1]
     # held for 0.7 s at 1.5 a second: the stick came back about 1 below where it was

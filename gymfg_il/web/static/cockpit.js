@@ -8,6 +8,8 @@ const EDGE = "rgb(120,130,150)", WHITE = "#fff", MAGENTA = "rgb(230,60,220)";
 const YELLOW = "rgb(250,210,40)", DIM = "rgb(150,158,170)", FG = "rgb(223,227,234)";
 const RED = "rgb(235,70,70)", GREEN = "rgb(80,200,120)";
 const PX_PER_DEG = 6, PX_PER_DOT = 30, SLIP_PX_PER_DEG = 12;
+// the primary flight display's instruments (gymfg_il.tasks.guidance.PRIMARY)
+const PFD = new Set(["airspeed", "altitude", "vertical_speed", "bank", "pitch", "heading", "slip"]);
 
 // browser key codes -> pygame key names (what the server's bindings use)
 const KEYS = {
@@ -54,6 +56,7 @@ function connect() {
       canvas.focus();
     } else if (message.type === "frame") {
       frame = message;
+      window.__frame = message;  // what tests compare the drawing with
       pollPad();
       answer();
       requestAnimationFrame(draw);
@@ -184,20 +187,24 @@ function draw() {
     return;
   }
   const readings = readingsOf(frame);
-  const values = {};
-  for (const r of readings) if (r.role === "value") values[r.name] = r.value;
-  const bugs = (instrument) => readings.filter((r) => r.instrument === instrument && r.role === "bug").map((r) => r.value);
+  const values = {}, drawn = new Set();  // drawn: every reading this frame shows (tests read it)
+  for (const r of readings) {
+    if (r.role === "value" && PFD.has(r.instrument)) { values[r.name] = r.value; drawn.add(r.name); }
+  }
+  const bugs = (instrument) => readings.filter((r) => r.instrument === instrument && r.role === "bug")
+    .map((r) => { drawn.add(r.name); return r.value; });
   statusBar();
   attitude(values, bugs("pitch"), bugs("bank"));
-  for (const r of readings) if (r.role === "needle") ils(r.instrument, r.value);
+  for (const r of readings) if (r.role === "needle") { ils(r.instrument, r.value); drawn.add(r.name); }
   tape(AI.cx - AI.size / 2 - 100, values.airspeed_kts, 10, 6, "kt", bugs("airspeed"));
   tape(AI.cx + AI.size / 2 + 12, values.altitude_ft, 100, 0.6, "ft", bugs("altitude"));
   verticalSpeed(AI.cx + AI.size / 2 + 112, values.vertical_speed_fps || 0);
   heading(values.heading_deg, bugs("heading"));
   slip(values.beta_deg || 0, bugs("slip"));
   controls();
-  panel(readings);
+  panel(readings, drawn);
   words();
+  window.__drawn = Array.from(drawn);
   if (frame.help) help();
   if (closedWhy) banner(closedWhy, RED, 700);
 }
@@ -358,8 +365,9 @@ function controls() {
   const c = frame.controls, trim = frame.trim, x0 = 60, y0 = 640, s = 70;
   text("STICK", x0 - 20, y0 - s - 12, DIM, 12);
   ctx.strokeStyle = EDGE; ctx.strokeRect(x0 - s + 20, y0 - s, 2 * s, 2 * s);
-  dot(x0 + 20 + trim[0] * s, y0 + trim[1] * s, 4, DIM);
-  dot(x0 + 20 + c[0] * s, y0 + c[1] * s, 7, GREEN);
+  // elevator positive (nose down: the stick forward) is drawn up, as in the pygame window
+  dot(x0 + 20 + trim[0] * s, y0 - trim[1] * s, 4, DIM);
+  dot(x0 + 20 + c[0] * s, y0 - c[1] * s, 7, GREEN);
   text("RUDDER", x0 + 110, y0 - s - 12, DIM, 12);
   ctx.strokeRect(x0 + 110, y0 - 8, 120, 16);
   dot(x0 + 170 + c[2] * 60, y0, 6, GREEN);
@@ -385,17 +393,18 @@ function spoken(r) {
   return (Math.abs(v) < 100 ? v.toFixed(1) : v.toFixed(0)) + " " + r.unit;
 }
 
-function panel(readings) {
+function panel(readings, drawn) {
   const left = 760, top = 110;
   text("TARGETS AND GUIDANCE", left, top - 20, DIM, 12);
   let y = top;
   for (const r of readings.filter((q) => q.role === "bug" || q.role === "guidance").slice(0, 10)) {
+    drawn.add(r.name);
     text(r.label, left, y, DIM, 13);
     text(spoken(r), left + 260, y, r.role === "bug" ? MAGENTA : FG, 14);
     y += 22;
   }
   const slot = {};
-  for (const r of readings) if (r.instrument === "slot") slot[r.name] = r.value;
+  for (const r of readings) if (r.instrument === "slot") { slot[r.name] = r.value; drawn.add(r.name); }
   if (Object.keys(slot).length) {
     const bx = left + 60, by = y + 20, w = 160, h = 180, cx = bx + w / 2, cy = by + h / 2, k = 0.3;
     ctx.strokeStyle = DIM; ctx.strokeRect(bx, by, w, h);
