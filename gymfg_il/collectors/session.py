@@ -34,6 +34,7 @@ from gymfg_il.workers import Workers
 
 DATASET = "dataset"
 INVITES = "invites.json"  # a web session's invites (``collect web``: ``web.invites``)
+PROBE = ".gymfg-write-check-"  # a session's check that it may write (a moment's file)
 log = logging.getLogger(__name__)
 
 __all__ = [
@@ -54,7 +55,7 @@ def check_out_folder(out: Path) -> None:
     try:
         out.mkdir(parents=True, exist_ok=True)
         # of this thread: the sessions of a web server check the same folder at once
-        probe = out / f".gymfg-write-check-{os.getpid()}-{threading.get_ident()}"
+        probe = out / f"{PROBE}{os.getpid()}-{threading.get_ident()}"
         probe.touch()
         probe.unlink()
     except OSError as err:
@@ -66,6 +67,7 @@ def check_out_folder(out: Path) -> None:
             p.name
             for p in out.iterdir()
             if p.name not in (LOGS, DATASET, INVITES)
+            and not p.name.startswith(PROBE)  # another session's, checking at the same time
             and not p.name.startswith(DATASET + ".")
             and not p.name.startswith("policy-")
         )

@@ -100,3 +100,30 @@ def test_a_web_config_names_what_is_wrong_and_the_fix(tmp_path, field, value, sa
 
     with pytest.raises(ConfigError, match=re.escape(said)):
         WebConfig(out=tmp_path, **{field: value})
+
+
+def test_sessions_checking_one_folder_at_once_never_refuse_one_another(tmp_path):
+    """Eight pilots' sessions start together on one folder: each one's write check (a file
+    of a moment) is neither another's nor a foreign file to another."""
+    import threading
+
+    from gymfg_il.collectors.session import check_out_folder
+
+    failures: list[Exception] = []
+
+    def check() -> None:
+        for _ in range(200):
+            try:
+                check_out_folder(tmp_path)
+            except Exception as err:  # collected, asserted below
+                failures.append(err)
+
+    threads = [threading.Thread(target=check) for _ in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not failures, failures[:3]
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(ConfigError, match=r"notes\.txt"):
+        check_out_folder(tmp_path)
