@@ -105,20 +105,23 @@ class Pilots:
     def start(self, pilot: Pilot, device: str) -> None:
         """Start the pilot's session (or keep it: the same device), and wait until it flies."""
         with self.lock:
-            if pilot.thread is not None and pilot.thread.is_alive():
-                if pilot.device == device:
-                    return
-                assert pilot.link is not None
+            running = pilot.thread is not None and pilot.thread.is_alive()
+            if running and pilot.device != device:
+                assert pilot.link is not None and pilot.thread is not None
                 pilot.link.stop = True  # another device: a new session, the next seed on
                 pilot.thread.join()
-            link = PilotLink(pilot.invite.name, self.say)
-            pilot.link, pilot.device = link, device
-            pilot.thread = threading.Thread(
-                target=self._run, args=(pilot, link, device), name=f"pilot-{pilot.invite.name}"
-            )
-            pilot.thread.daemon = True
-            pilot.thread.start()
-        link.ready.wait(START_S)
+            if not running or pilot.device != device:
+                pilot.link, pilot.device = PilotLink(pilot.invite.name, self.say), device
+                pilot.thread = threading.Thread(
+                    target=self._run,
+                    args=(pilot, pilot.link, device),
+                    name=f"pilot-{pilot.invite.name}",
+                    daemon=True,
+                )
+                pilot.thread.start()
+            link = pilot.link
+            assert link is not None
+        link.ready.wait(START_S)  # (a page that came while it starts waits here too)
         if not link.ready.is_set():
             link.failed = f"it did not start within {START_S} s"
 

@@ -197,11 +197,12 @@ class WebServer:
         flying = sum(p.socket is not None and p is not pilot for p in self.pilots.by_name.values())
         if flying >= self.config.pilots:
             raise ProtocolError(f"the server is full ({self.config.pilots} pilots); try later")
-        if pilot.socket is not None:  # the newest page flies
-            old, pilot.socket = pilot.socket, None
+        old, pilot.socket = pilot.socket, websocket  # the newest page flies
+        if old is not None:
             await self._close(old, 1008, "this invite was opened again elsewhere", pilot)
-        pilot.socket = websocket
         await asyncio.to_thread(self.pilots.start, pilot, said.device)
+        if pilot.socket is not websocket:  # a newer page took over meanwhile (it was told)
+            return None
         assert pilot.link is not None
         if pilot.link.failed is not None:
             raise ProtocolError(f"the session could not start: {pilot.link.failed}")
@@ -225,6 +226,8 @@ class WebServer:
         from gymfg_il.web.protocol import encode
 
         await websocket.send_text(encode(link.welcome).decode())
+        if pilot.socket is not websocket or pilot.link is not link:  # taken over meanwhile
+            return
         link.attach(sender)
         send = asyncio.create_task(self._send(websocket, newest, wake, link))
         try:

@@ -191,3 +191,36 @@ def test_serving_beyond_this_machine_says_so_and_how_to_do_it_safely(serve):
     warning = served.wait_for(r"^WARNING: serving on 0\.0\.0\.0")
     assert "TLS proxy" in warning and "docs/guides/web.md" in warning
     assert served.stop() == 0
+
+
+def test_pages_racing_for_one_invite_leave_the_newest_flying(serve):
+    """Six pages open one invite at once, while its session is still starting: one flies,
+    each of the others is told why it closed."""
+    from websockets.asyncio.client import connect
+    from websockets.exceptions import ConnectionClosed
+
+    served = serve("--pilots", "2", "--episode-time", "3")  # (4 sockets a pilot: room for 6)
+    hello = orjson.dumps({"type": "hello", "invite": served.invites["pilot-1"]})
+
+    async def page():
+        frames = 0
+        async with connect(served.ws) as ws:
+            await ws.send(hello)
+            try:
+                async with asyncio.timeout(6):
+                    async for data in ws:
+                        frames += orjson.loads(data)["type"] == "frame"
+            except (TimeoutError, ConnectionClosed):
+                pass
+            return frames, ws.close_reason
+
+    async def race():
+        return await asyncio.gather(*(page() for _ in range(6)))
+
+    results = asyncio.run(race())
+    flying = [r for r in results if r[0] > 60]  # frames still coming after seconds
+    assert len(flying) == 1, results
+    told = [r[1] for r in results if r not in flying]
+    assert told == ["this invite was opened again elsewhere"] * 5, results
+    assert asyncio.run(fly(served.ws, served.invites["pilot-1"], 1)).saved == 1
+    assert served.stop() == 0
