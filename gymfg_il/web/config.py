@@ -57,12 +57,13 @@ class WebConfig(CollectConfig):
         """Served beyond this machine (the server warns)."""
         return self.host not in LOOPBACK
 
-    def pilot_session(self, name: str, seed: int, device: str) -> ManualConfig:
-        """The cockpit session of one pilot (``cockpit.session``), flying from ``seed``."""
+    def pilot_session(self, name: str, seed: int, device: str, episodes: int) -> ManualConfig:
+        """The cockpit session of one pilot (``cockpit.session``), flying from ``seed``, to
+        save ``episodes`` (0: until the server stops)."""
         options: dict[str, Any] = FlightOptions.given(self)
         return ManualConfig(
             **options,
-            episodes=self.episodes,
+            episodes=episodes,
             seed=seed,
             out=self.out,
             images=list(self.images),

@@ -38,6 +38,7 @@ from gymfg_il.manual.controller import ManualController
 from gymfg_il.web.protocol import Input, encode
 
 SENT_KEPT = 256  # frames whose send time is kept (an input answering an older one is old)
+SILENT_S = 1.0  # a page that answers no frame for this long is gone, whatever its socket says
 
 
 class PilotLink:
@@ -59,6 +60,7 @@ class PilotLink:
         self.close_reason: str | None = None  # the page's socket is to close, saying why
         self.stop = False  # the server is closing: the session ends
         self.frame = 0  # frames sent (the next frame's number)
+        self.heard = time.perf_counter()  # when the page last sent an input (or came)
         self.sent_at: dict[int, float] = {}
         self.welcome: dict[str, Any] | None = None  # set once the session is built
         self.ready = threading.Event()
@@ -70,6 +72,7 @@ class PilotLink:
             self.sender, self.connected, self.quit = sender, True, False
             self.close_reason = None
             self.inbox.clear()
+            self.heard = time.perf_counter()
 
     def detach(self) -> None:
         with self.lock:
@@ -84,7 +87,8 @@ class PilotLink:
             sender(b"")  # wakes the socket's sender, which closes it
 
     def received(self, message: Input) -> None:
-        self.inbox.append((message, time.perf_counter()))
+        self.heard = now = time.perf_counter()
+        self.inbox.append((message, now))
 
     # -- the session's side -------------------------------------------------------------
     def take(self) -> list[tuple[Input, float]]:
@@ -137,6 +141,10 @@ class WebInput:
                 wall = time.time() - (time.perf_counter() - arrived)
                 self._newest = (message.frame, arrived - sent, wall)
         read_at = time.time()
+        silent = time.perf_counter() - link.heard > SILENT_S
+        if seen.phase != "idle" and link.connected and silent:  # a line that died unclosed
+            link.dropped, link.heard = True, time.perf_counter()
+            link.say(f"pilot {link.name}: no input for {SILENT_S:g} s")
         if link.dropped or link.quit or link.stop:
             link.dropped = False
             self.human.held.clear()  # keys held when the page went are let go

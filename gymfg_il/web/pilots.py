@@ -13,7 +13,7 @@ import logging
 import re
 import threading
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +22,7 @@ from gymfg_il.cockpit.updater import DatasetUpdater
 from gymfg_il.web.config import WebConfig
 from gymfg_il.web.invites import Invite
 from gymfg_il.web.link import PilotLink, WebInput, WebWindow
+from gymfg_il.web.protocol import JOINS_BURST, JOINS_HZ, RateLimit
 
 log = logging.getLogger(__name__)
 
@@ -63,7 +64,8 @@ class SharedUpdater(DatasetUpdater):
 
 @dataclass
 class Pilot:
-    """One invite's pilot: their session (a thread), its link, the socket flying it."""
+    """One invite's pilot: their session (a thread), its link, the socket flying it, the
+    episodes they saved in sessions that ended, how often their invite is opened."""
 
     invite: Invite
     next_seed: int
@@ -72,6 +74,10 @@ class Pilot:
     device: str | None = None
     socket: Any = None
     saved: int = 0
+    lock: threading.Lock = field(default_factory=threading.Lock)
+    joins: RateLimit = field(
+        default_factory=lambda: RateLimit(JOINS_HZ, JOINS_BURST, "openings of an invite")
+    )
 
 
 def _file_name(name: str) -> str:
@@ -102,14 +108,17 @@ class Pilots:
         self.lock = threading.Lock()
 
     # -- a pilot's session ----------------------------------------------------------------
-    def start(self, pilot: Pilot, device: str) -> None:
-        """Start the pilot's session (or keep it: the same device), and wait until it flies."""
-        with self.lock:
+    def start(self, pilot: Pilot, device: str) -> str | None:
+        """Start the pilot's session (or keep it: the same device) and wait until it flies;
+        why it could not, or None."""
+        with pilot.lock:
             running = pilot.thread is not None and pilot.thread.is_alive()
             if running and pilot.device != device:
                 assert pilot.link is not None and pilot.thread is not None
                 pilot.link.stop = True  # another device: a new session, the next seed on
-                pilot.thread.join()
+                pilot.thread.join(START_S)
+                if pilot.thread.is_alive():
+                    return "the session of the other device does not end"
             if not running or pilot.device != device:
                 pilot.link, pilot.device = PilotLink(pilot.invite.name, self.say), device
                 pilot.thread = threading.Thread(
@@ -121,14 +130,15 @@ class Pilots:
                 pilot.thread.start()
             link = pilot.link
             assert link is not None
-        link.ready.wait(START_S)  # (a page that came while it starts waits here too)
-        if not link.ready.is_set():
-            link.failed = f"it did not start within {START_S} s"
+        if not link.ready.wait(START_S):  # (a page that came while it starts waits here too)
+            return f"it did not start within {START_S} s; try again"
+        return link.failed
 
     def _run(self, pilot: Pilot, link: PilotLink, device: str) -> None:
         from gymfg_il.cockpit.session import ManualSession
 
-        config = self.config.pilot_session(pilot.invite.name, pilot.next_seed, device)
+        left = self.config.episodes - pilot.saved if self.config.episodes else 0
+        config = self.config.pilot_session(pilot.invite.name, pilot.next_seed, device, left)
         options = self.flight_options
         say = self.say
 

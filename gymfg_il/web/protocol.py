@@ -30,7 +30,8 @@ import orjson
 MAX_MESSAGE_BYTES = 4096  # a message larger than this closes the socket
 MAX_EVENTS = 64  # events in one input message
 MAX_RATE_HZ = 240  # input messages per second (a burst of one second's worth is allowed)
-HELLO_S = 10.0  # seconds a new socket has to say hello
+HELLO_S = 3.0  # seconds a new socket has to say hello
+JOINS_HZ, JOINS_BURST = 1.0, 8  # an invite opened at most once a second (after a burst)
 TOKEN_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_")
 DEVICES = ("keyboard", "mouse", "joystick")
 AXES = 8  # gamepad axes read
@@ -157,20 +158,22 @@ def inputs(message: dict[str, Any], last_seq: int) -> Input:
 
 
 class RateLimit:
-    """At most ``hz`` messages a second on average, a burst of one second's worth allowed (a
-    token bucket on the caller's clock)."""
+    """At most ``hz`` a second on average, a burst of ``burst`` (default: one second's worth)
+    allowed (a token bucket on the caller's clock); ``what`` is counted."""
 
-    def __init__(self, hz: float = MAX_RATE_HZ) -> None:
-        self.hz = hz
-        self.tokens = hz
+    def __init__(
+        self, hz: float = MAX_RATE_HZ, burst: float | None = None, what: str = "messages"
+    ) -> None:
+        self.hz, self.burst, self.what = hz, hz if burst is None else burst, what
+        self.tokens = self.burst
         self.at: float | None = None
 
     def take(self, now: float) -> None:
         if self.at is not None:
-            self.tokens = min(self.hz, self.tokens + (now - self.at) * self.hz)
+            self.tokens = min(self.burst, self.tokens + (now - self.at) * self.hz)
         self.at = now
         if self.tokens < 1.0:
-            raise ProtocolError(f"more than {self.hz:g} messages a second")
+            raise ProtocolError(f"more than {self.hz:g} {self.what} a second")
         self.tokens -= 1.0
 
 

@@ -29,6 +29,7 @@ import time
 from collections.abc import Callable
 from importlib import resources
 from typing import Any
+from urllib.parse import urlsplit
 
 from gymfg_il.collectors.session import check_appendable, check_out_folder
 from gymfg_il.envs.options import FlightOptions
@@ -49,8 +50,17 @@ from gymfg_il.web.protocol import (
 
 log = logging.getLogger(__name__)
 
-SOCKETS_PER_PILOT = 4  # open sockets allowed (flying or not yet) per pilot slot
+WAITING_PER_INVITE = 2  # sockets that have not said hello yet, per invite (and 4 more)
 NEEDS = "the web cockpit needs its extra: pip install -e '.[web]' (starlette, uvicorn, websockets)"
+
+
+def _same_origin(headers: Any) -> bool:
+    """A page from this server, or no page at all (a client that is not a browser sends no
+    Origin): another site's page in a pilot's browser may not open sockets here."""
+    origin = headers.get("origin")
+    if origin is None:
+        return True
+    return urlsplit(origin).netloc == headers.get("host", "")
 
 
 class WebServer:
@@ -86,7 +96,7 @@ class WebServer:
         )
         self.invites = invites(config.out, names, config.seed)
         self.pilots = Pilots(config, self.invites, self.flight_options, self.say)
-        self.sockets = 0
+        self.waiting = 0  # sockets that have not said hello yet
         self.port = config.port
         self.serving = threading.Event()
         self._uvicorn: Any = None
@@ -141,15 +151,17 @@ class WebServer:
     # -- a pilot's socket -----------------------------------------------------------------
     async def socket(self, websocket: Any) -> None:
         """One page's websocket, from hello to close (module docstring)."""
-        limit = SOCKETS_PER_PILOT * len(self.invites)
-        if self.sockets >= limit:
-            await websocket.close(code=1013)  # refused before it is accepted
+        if not _same_origin(websocket.headers) or self.waiting >= self._waiting_limit():
+            await websocket.close(code=1013)  # refused before it is accepted (HTTP 403)
             return
-        self.sockets += 1
         pilot: Pilot | None = None
+        self.waiting += 1
         try:
             await websocket.accept()
-            pilot = await self._join(websocket)
+            try:
+                pilot = await self._join(websocket)
+            finally:
+                self.waiting -= 1
             if pilot is not None:
                 await self._fly(websocket, pilot)
         except ProtocolError as err:
@@ -159,12 +171,14 @@ class WebServer:
                 log.exception("a pilot's socket failed")
                 await self._close(websocket, 1011, f"server error: {type(err).__name__}", pilot)
         finally:
-            self.sockets -= 1
             if pilot is not None and pilot.socket is websocket:
                 pilot.socket = None
                 if pilot.link is not None:
                     pilot.link.detach()
                 self.say(f"pilot {pilot.invite.name} left")
+
+    def _waiting_limit(self) -> int:
+        return WAITING_PER_INVITE * len(self.invites) + 4
 
     async def _close(self, websocket: Any, code: int, reason: str, pilot: Pilot | None) -> None:
         who = f"pilot {pilot.invite.name}" if pilot is not None else "a page"
@@ -192,6 +206,7 @@ class WebServer:
         if invite is None:
             raise ProtocolError("no such invite")
         pilot = self.pilots.by_name[invite.name]
+        pilot.joins.take(time.monotonic())  # a storm of reopenings is refused
         if self.config.episodes and pilot.saved >= self.config.episodes:
             raise ProtocolError(f"you have saved your {pilot.saved} episode(s); thank you")
         flying = sum(p.socket is not None and p is not pilot for p in self.pilots.by_name.values())
@@ -199,13 +214,15 @@ class WebServer:
             raise ProtocolError(f"the server is full ({self.config.pilots} pilots); try later")
         old, pilot.socket = pilot.socket, websocket  # the newest page flies
         if old is not None:
+            if pilot.link is not None:  # the episode in flight was the other page's
+                pilot.link.detach()
             await self._close(old, 1008, "this invite was opened again elsewhere", pilot)
-        await asyncio.to_thread(self.pilots.start, pilot, said.device)
+        failed = await asyncio.to_thread(self.pilots.start, pilot, said.device)
         if pilot.socket is not websocket:  # a newer page took over meanwhile (it was told)
             return None
-        assert pilot.link is not None
-        if pilot.link.failed is not None:
-            raise ProtocolError(f"the session could not start: {pilot.link.failed}")
+        if failed is not None:
+            pilot.socket = None
+            raise ProtocolError(f"the session could not start: {failed}")
         self.say(f"pilot {invite.name} joined ({said.device})")
         return pilot
 
@@ -280,6 +297,8 @@ class WebServer:
                 port=self.config.port,
                 ws="websockets-sansio",
                 ws_max_size=MAX_MESSAGE_BYTES,
+                ws_ping_interval=5.0,  # a line that died unclosed is closed within 10 s
+                ws_ping_timeout=5.0,
                 log_level="warning",
                 lifespan="off",
             )

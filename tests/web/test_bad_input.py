@@ -5,6 +5,7 @@ is refused with a reason; the server flies on and the pilot's episodes are all s
 from __future__ import annotations
 
 import asyncio
+import itertools
 
 import orjson
 import pytest
@@ -118,41 +119,59 @@ async def _refused(url: str, payloads: list, hello: str | None = None) -> tuple[
         return ws.close_code, ws.close_reason
 
 
-def test_over_a_hundred_bad_inputs_are_refused_with_reasons_and_nothing_saved_is_lost(serve):
-    served = serve("--episode-time", "4", "--pilots", "3")
-    flyer, other = served.invites["pilot-1"], served.invites["pilot-2"]
-    hello = orjson.dumps({"type": "hello", "invite": other}).decode()
+def test_over_a_hundred_bad_inputs_are_refused_with_reasons_and_nothing_saved_is_lost(
+    serve, tmp_path
+):
+    names = tmp_path / "pilots.txt"
+    names.write_text("".join(f"pilot-{k}\n" for k in range(1, 13)))
+    served = serve("--episode-time", "4", "--pilots", "3", "--invites", str(names))
+    flyer = served.invites["pilot-1"]
+    hellos = itertools.cycle(  # each invite opened at most eight times in a burst
+        orjson.dumps({"type": "hello", "invite": served.invites[f"pilot-{k}"]}).decode()
+        for k in range(2, 12)
+    )
     refused: list[tuple[str, int, str]] = []
 
     async def attack():
         for payload in BEFORE_HELLO:
             refused.append((str(payload)[:40], *await _refused(served.ws, [payload])))
         for payload in AFTER_HELLO:
-            refused.append((str(payload)[:40], *await _refused(served.ws, [payload], hello)))
+            said = await _refused(served.ws, [payload], next(hellos))
+            refused.append((str(payload)[:40], *said))
         # a repeated sequence number, then a flood far above the rate limit
         repeat = [_input(seq=5), _input(seq=5)]
-        refused.append(("repeated seq", *await _refused(served.ws, repeat, hello)))
+        refused.append(("repeated seq", *await _refused(served.ws, repeat, next(hellos))))
         flood = [_input(seq=k + 1) for k in range(2000)]
-        refused.append(("flood", *await _refused(served.ws, flood, hello)))
+        refused.append(("flood", *await _refused(served.ws, flood, next(hellos))))
         # the same invite opened twice: the older page is told why it closes
+        hello = next(hellos)
         first = asyncio.ensure_future(_refused(served.ws, [], hello))
         await asyncio.sleep(2.0)
-        await _storm(1)
+        await storm(hello, 1)
         refused.append(("reused invite", *await first))
 
-    async def _storm(n: int) -> None:  # pages that come and go at once
+    async def storm(hello: str, n: int) -> None:  # pages that come and go at once
         from websockets.asyncio.client import connect
+        from websockets.exceptions import ConnectionClosed
 
         for _ in range(n):
             async with connect(served.ws) as ws:
                 await ws.send(hello)
+                try:
+                    async with asyncio.timeout(0.5):
+                        await ws.recv()  # a welcome, or the reason it was refused
+                        await ws.recv()
+                except (TimeoutError, ConnectionClosed):
+                    pass
+                if ws.close_code is not None:
+                    refused.append(("storm", ws.close_code, ws.close_reason))
 
     async def unannounced():  # sockets that never say hello: refused past the limit
         from websockets.asyncio.client import connect
         from websockets.exceptions import ConnectionClosed, InvalidStatus
 
         opened, codes = [], []
-        for _ in range(14):
+        for _ in range(32):
             try:
                 opened.append(await connect(served.ws))
             except InvalidStatus as err:
@@ -164,12 +183,17 @@ def test_over_a_hundred_bad_inputs_are_refused_with_reasons_and_nothing_saved_is
             except ConnectionClosed:
                 codes.append(ws.close_code)
                 refused.append(("no hello", ws.close_code, ws.close_reason))
+        try:  # a page of another site, in a pilot's browser
+            await connect(served.ws, origin="http://elsewhere.example")
+        except InvalidStatus as err:
+            codes.append(err.response.status_code)
+            refused.append(("another site", 1008, "refused before the handshake"))
         return codes
 
     async def everything():
         flying = asyncio.ensure_future(fly(served.ws, flyer, 2))
         await attack()
-        await _storm(30)
+        await storm(next(hellos), 30)
         codes = await unannounced()
         return await flying, codes
 
@@ -180,12 +204,13 @@ def test_over_a_hundred_bad_inputs_are_refused_with_reasons_and_nothing_saved_is
     assert not unexplained, unexplained
     assert any(r[2] == "this invite was opened again elsewhere" for r in refused)
     assert any("messages a second" in r[2] for r in refused)
+    assert any("openings of an invite a second" in r[2] for r in refused)  # the storm
     assert any(r[2].startswith("no hello within") for r in refused)
-    assert 403 in codes  # past the socket limit, refused before the handshake ends
+    assert codes.count(403) >= 2  # past the waiting limit, and the other site
     # a well-behaved page still flies, and every saved episode is in the dataset
-    assert asyncio.run(fly(served.ws, served.invites["pilot-3"], 1)).saved == 1
+    assert asyncio.run(fly(served.ws, served.invites["pilot-12"], 1)).saved == 1
     assert served.stop() == 0
-    served.wait_for(r"saved 3 episode\(s\) from 3 invite\(s\); dataset: ")
+    served.wait_for(r"saved 3 episode\(s\) from 12 invite\(s\); dataset: ")
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     data = LeRobotDataset("local/web", root=served.out / "dataset")

@@ -224,3 +224,66 @@ def test_pages_racing_for_one_invite_leave_the_newest_flying(serve):
     assert told == ["this invite was opened again elsewhere"] * 5, results
     assert asyncio.run(fly(served.ws, served.invites["pilot-1"], 1)).saved == 1
     assert served.stop() == 0
+
+
+async def _start_episode(ws, frames: int, events=()) -> dict:
+    """Press Space, fly ``frames`` frames of the episode answering each (``events`` once);
+    the last frame seen."""
+    seq = 0
+    async for data in ws:
+        message = orjson.loads(data)
+        if message["type"] != "frame":
+            continue
+        seq += 1
+        sent = [["down", "space"], ["up", "space"]] if message["status"] == "idle" else []
+        if message["status"] == "recording":
+            frames -= 1
+            sent, events = list(events), ()
+        await ws.send(orjson.dumps({"type": "input", "seq": seq, "at": 0, "frame": message["n"],
+                                    "events": sent}))  # fmt: skip
+        if frames <= 0:
+            return message
+    raise AssertionError("the socket closed")
+
+
+def test_a_page_that_goes_silent_or_is_replaced_loses_its_episode_in_flight(serve):
+    """A line that dies without closing (a laptop asleep) or another page opening the same
+    invite: the episode in flight is discarded, never saved with input nobody gave."""
+    from websockets.asyncio.client import connect
+
+    served = serve("--episode-time", "3", "--pilots", "1")
+    hello = orjson.dumps({"type": "hello", "invite": served.invites["pilot-1"]})
+
+    async def silent():
+        async with connect(served.ws) as ws:
+            await ws.send(hello)
+            await _start_episode(ws, 10, [["down", "up"]])  # holding a key, then nothing
+            await asyncio.sleep(4.0)  # longer than the episode: it would have ended
+
+    async def replaced():
+        async with connect(served.ws) as first:
+            await first.send(hello)
+            await _start_episode(first, 10, [["down", "up"]])
+            async with connect(served.ws) as second:
+                await second.send(hello)
+                await asyncio.sleep(4.0)
+
+    asyncio.run(silent())
+    served.wait_for(r"pilot pilot-1: no input for 1 s")
+    asyncio.run(replaced())
+    assert len(served.said(r"the connection dropped; the episode in flight was discarded")) == 2
+    assert not served.said(r"saved episode")
+    assert served.stop() == 0
+    assert _episodes(served.out) == []
+
+
+def test_episodes_caps_what_a_pilot_saves_whatever_device_they_fly(serve):
+    served = serve("--episode-time", "2", "--pilots", "1", "--episodes", "2")
+    token = served.invites["pilot-1"]
+    assert asyncio.run(fly(served.ws, token, 1)).saved == 1
+    flown = asyncio.run(fly(served.ws, token, 5, device="mouse"))  # a new session: one left
+    assert flown.saved == 1 and flown.closed == "thank you: you saved your 2 episode(s)"
+    again = asyncio.run(fly(served.ws, token, 1))
+    assert again.closed == "you have saved your 2 episode(s); thank you"
+    assert served.stop() == 0
+    assert len(_episodes(served.out)) == 2

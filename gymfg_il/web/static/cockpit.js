@@ -39,6 +39,7 @@ function connect() {
   const scheme = location.protocol === "https:" ? "wss:" : "ws:";
   const socket = new WebSocket(scheme + "//" + location.host + "/ws");
   ws = socket;
+  pending = []; held.clear();  // nothing pressed before this socket reaches its session
   stateText.textContent = "connecting";
   stateText.className = "";
   socket.onopen = () => {
@@ -52,14 +53,15 @@ function connect() {
       closedWhy = "";
       stateText.textContent = "flying as " + message.pilot + " (" + message.device + ")";
       calibrateText.hidden = message.device !== "joystick";
-      pad = { index: -1, axes: [], buttons: [], centre: [] };
+      // the new session hears of the pad again; its centre, measured once, is kept
+      pad = { index: -1, axes: [], buttons: [], centre: pad.centre };
       canvas.focus();
     } else if (message.type === "frame") {
       frame = message;
       window.__frame = message;  // what tests compare the drawing with
       pollPad();
       answer();
-      requestAnimationFrame(draw);
+      redraw();
     }
   };
   socket.onclose = (event) => {
@@ -68,11 +70,21 @@ function connect() {
     stateText.textContent = closedWhy;
     stateText.className = "bad";
     ws = null;
+    pending = []; held.clear();
     const again = event.code === 1006 || event.code === 1001 || event.code === 1011;
     if (wanted && again) retry = setTimeout(connect, 1000);  // a dropped line: resume
-    requestAnimationFrame(draw);
+    redraw();
   };
 }
+
+let drawing = false;  // one draw waits for the screen at a time (a hidden tab piles none up)
+function redraw() {
+  if (drawing) return;
+  drawing = true;
+  requestAnimationFrame(() => { drawing = false; draw(); });
+}
+
+function flying() { return ws !== null && ws.readyState === WebSocket.OPEN && welcome !== null; }
 
 function answer() {
   if (!ws || ws.readyState !== WebSocket.OPEN || !frame) return;
@@ -95,7 +107,7 @@ const held = new Set();
 window.addEventListener("keydown", (event) => {
   if (event.code === "KeyC" && welcome && welcome.device === "joystick") { calibrate(); return; }
   const name = KEYS[event.code];
-  if (!name || !welcome) return;
+  if (!name || !flying()) return;
   event.preventDefault();
   if (event.repeat || held.has(name)) return;
   held.add(name);
@@ -113,7 +125,10 @@ window.addEventListener("blur", () => {  // keys held when the page loses focus 
   held.clear();
 });
 canvas.addEventListener("mousemove", (event) => {
-  if (!welcome || welcome.device !== "mouse") return;
+  if (!flying() || welcome.device !== "mouse") return;
+  for (let i = pending.length - 1; i >= 0; i--) {  // only the newest pointer position counts
+    if (pending[i][0] === "mouse") { pending.splice(i, 1); break; }
+  }
   const rect = canvas.getBoundingClientRect();
   const [w, h] = welcome.stick.size;
   // the stick box is centred on the attitude indicator, the pointer scaled to the server's
@@ -433,6 +448,6 @@ function help() {
   welcome.help.forEach((line, i) => text(line, 80, 110 + 20 * i, FG, 13));
 }
 
-requestAnimationFrame(draw);
+redraw();
 if (invite) connect();
 else stateText.textContent = "no invite in this link: open the link you were given";
