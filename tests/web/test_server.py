@@ -193,6 +193,7 @@ def test_serving_beyond_this_machine_says_so_and_how_to_do_it_safely(serve):
     assert served.stop() == 0
 
 
+@pytest.mark.slow
 def test_pages_racing_for_one_invite_leave_the_newest_flying(serve):
     """Six pages open one invite at once, while its session is still starting: one flies,
     each of the others is told why it closed."""
@@ -277,6 +278,7 @@ def test_a_page_that_goes_silent_or_is_replaced_loses_its_episode_in_flight(serv
     assert _episodes(served.out) == []
 
 
+@pytest.mark.slow
 def test_episodes_caps_what_a_pilot_saves_whatever_device_they_fly(serve):
     served = serve("--episode-time", "2", "--pilots", "1", "--episodes", "2")
     token = served.invites["pilot-1"]
