@@ -44,6 +44,7 @@ from gymfg_il.web.protocol import (
     ProtocolError,
     RateLimit,
     decode,
+    encode,
     hello,
     inputs,
 )
@@ -239,8 +240,6 @@ class WebServer:
 
         def sender(data: bytes) -> None:  # from the session's thread
             loop.call_soon_threadsafe(put, data)
-
-        from gymfg_il.web.protocol import encode
 
         await websocket.send_text(encode(link.welcome).decode())
         if pilot.socket is not websocket or pilot.link is not link:  # taken over meanwhile

@@ -4,6 +4,7 @@ gamepad, and the logged actions follow."""
 
 from __future__ import annotations
 
+import contextlib
 import shutil
 
 import numpy as np
@@ -35,11 +36,18 @@ def _episodes(out):
     return [e for log in logs for e in read_log(log).complete_episodes]
 
 
-def _open(browser, served, errors):
-    page = browser.new_page(viewport={"width": 1280, "height": 860}, bypass_csp=True)
-    page.on("pageerror", lambda err: errors.append(str(err)))
-    page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
-    return page
+@contextlib.contextmanager
+def _page(errors, init: str | None = None):
+    """A Chromium page whose script errors go to ``errors`` (``init``: a script run first)."""
+    with playwright.sync_playwright() as p:
+        browser = _browser(p)
+        page = browser.new_page(viewport={"width": 1280, "height": 860}, bypass_csp=True)
+        page.on("pageerror", lambda err: errors.append(str(err)))
+        page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+        if init is not None:
+            page.add_init_script(init)
+        yield page
+        browser.close()
 
 
 def _fly_with(page, served, device: str) -> None:
@@ -58,16 +66,13 @@ def test_the_page_draws_every_reading_of_the_display_model(serve, task):
     the slot and the guidance, is on the page (the approach's: the keys test below)."""
     served = serve("--episode-time", "5", "--pilots", "1", "--task", task)
     errors: list[str] = []
-    with playwright.sync_playwright() as p:
-        browser = _browser(p)
-        page = _open(browser, served, errors)
+    with _page(errors) as page:
         page.goto(f"{served.base}/fly#invite={served.invites['pilot-1']}")
         page.wait_for_function("document.getElementById('state').textContent.startsWith('flying')")
         page.keyboard.press("Space")
         page.wait_for_function("window.__frame && window.__frame.status === 'recording'")
         page.wait_for_timeout(500)
         drawn, frame = page.evaluate("[window.__drawn, window.__frame]")
-        browser.close()
     assert not errors, errors
     assert set(drawn) == {r[0] for r in frame["readings"]}
     assert served.stop() == 0
@@ -76,9 +81,7 @@ def test_the_page_draws_every_reading_of_the_display_model(serve, task):
 def test_keys_pressed_in_chromium_are_the_actions_in_the_log(serve, tmp_path):
     served = serve("--episode-time", "4", "--pilots", "1", "--task", "approach")
     errors: list[str] = []
-    with playwright.sync_playwright() as p:
-        browser = _browser(p)
-        page = _open(browser, served, errors)
+    with _page(errors) as page:
         page.goto(f"{served.base}/fly#invite={served.invites['pilot-1']}")
         page.wait_for_function("document.getElementById('state').textContent.startsWith('flying')")
         page.wait_for_timeout(500)
@@ -94,7 +97,6 @@ def test_keys_pressed_in_chromium_are_the_actions_in_the_log(serve, tmp_path):
         served.wait_for(r"pilot pilot-1 saved episode 1", timeout=30)
         page.wait_for_timeout(300)
         text = page.evaluate("document.getElementById('state').textContent")
-        browser.close()
     assert not errors, errors
     assert text.startswith("flying as pilot-1")
     names = {r[0] for r in frame["readings"]}
@@ -111,10 +113,7 @@ def test_keys_pressed_in_chromium_are_the_actions_in_the_log(serve, tmp_path):
 def test_an_emulated_gamepad_flies_after_its_calibration(serve):
     served = serve("--episode-time", "3", "--pilots", "1")
     errors: list[str] = []
-    with playwright.sync_playwright() as p:
-        browser = _browser(p)
-        page = _open(browser, served, errors)
-        page.add_init_script(FAKE_PAD)
+    with _page(errors, FAKE_PAD) as page:
         page.goto(f"{served.base}/fly")  # no invite in the link: it says so, and waits
         assert "no invite" in page.evaluate("document.getElementById('state').textContent")
         page.evaluate("window.__pad.axes[1] = 0.1")  # a stick that rests off centre
@@ -127,7 +126,6 @@ def test_an_emulated_gamepad_flies_after_its_calibration(serve):
         page.wait_for_timeout(800)
         page.evaluate("window.__pad.axes[1] = 0.1")
         served.wait_for(r"pilot pilot-1 saved episode 1", timeout=30)
-        browser.close()
     assert not errors, errors
     (episode,) = _episodes(served.out)
     assert episode.start["pilot"] == "pilot-1"
@@ -142,9 +140,7 @@ def test_an_emulated_gamepad_flies_after_its_calibration(serve):
 def test_the_mouse_stick_follows_the_pointer_over_the_attitude_indicator(serve):
     served = serve("--episode-time", "3", "--pilots", "1")
     errors: list[str] = []
-    with playwright.sync_playwright() as p:
-        browser = _browser(p)
-        page = _open(browser, served, errors)
+    with _page(errors) as page:
         _fly_with(page, served, "mouse")
         box = page.locator("#cockpit").bounding_box()
         scale = box["width"] / 1200
@@ -159,7 +155,6 @@ def test_the_mouse_stick_follows_the_pointer_over_the_attitude_indicator(serve):
         page.wait_for_timeout(700)
         page.mouse.move(*at(-150), steps=5)  # full left
         served.wait_for(r"pilot pilot-1 saved episode 1", timeout=30)
-        browser.close()
     assert not errors, errors
     (episode,) = _episodes(served.out)
     aileron = episode.steps["ego"].action[:, 0]

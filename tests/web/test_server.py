@@ -89,26 +89,7 @@ def test_a_dropped_page_loses_its_episode_in_flight_and_the_same_invite_flies_it
 
         async with connect(served.ws) as ws:
             await ws.send(orjson.dumps({"type": "hello", "invite": token, "device": "keyboard"}))
-            seq = 0
-            async for data in ws:
-                message = orjson.loads(data)
-                if message["type"] != "frame":
-                    continue
-                seq += 1
-                events = [["down", "space"], ["up", "space"]] if message["status"] == "idle" else []
-                if message["status"] == "recording" and message["steps"] > 20:
-                    return message["seed"]  # leave, mid-episode
-                await ws.send(
-                    orjson.dumps(
-                        {
-                            "type": "input",
-                            "seq": seq,
-                            "at": 1.0,
-                            "frame": message["n"],
-                            "events": events,
-                        }
-                    )
-                )
+            return (await _start_episode(ws, 21))["seed"]  # leave, mid-episode
 
     seed = asyncio.run(leave_mid_episode())
     served.wait_for(r"pilot pilot-1: the connection dropped; the episode in flight was discarded")
