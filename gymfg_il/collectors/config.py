@@ -35,10 +35,10 @@ class CollectConfig(FlightOptions):
         episodes: episodes to record (manual: 0 = until you quit).
         seed: seed of the first episode (episode i uses seed + i); from 1000, so that `eval`,
             whose seeds start at 0, flies cases the demonstrations never showed.
-        noise: autopilot only: DART-style noise: std of Gaussian noise added to the executed
-            surfaces (the dataset keeps the demonstrator's clean action as the label), so the
-            demonstrations show how to recover from small deviations, which behaviour cloning
-            from a controller's demonstrations needs; 0 = none.
+        noise: autopilot only: DART-style noise: std of Gaussian noise added to each executed
+            control, throttle included (the dataset keeps the demonstrator's clean action as
+            the label), so the demonstrations show how to recover from small deviations,
+            which behaviour cloning from a controller's demonstrations needs; 0 = none.
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
         images: camera views to add to the dataset as LeRobot video features
             ``observation.images.<view>``: ``front`` (the pilot's eye) and/or ``chase``
@@ -156,7 +156,7 @@ class ManualConfig(CollectConfig):
             as the machine allows; its episodes are source=synthetic).
         skill: the synthetic pilot's level, 0 (a novice) to 1 (an ace).
         noise: the synthetic pilot only: DART-style noise, the std of Gaussian noise added
-            to the surfaces it flies, drawn from each episode's seed; the dataset keeps the
+            to every control it flies, drawn from each episode's seed; the dataset keeps the
             pilot's own action as the label, so its episodes show recoveries from the
             deviations; 0 = none. A person shows recoveries with --gusts instead.
         pilot_name: who flies this session, stored with each episode (the card lists pilots,

@@ -12,7 +12,7 @@ env are flown by the env and recorded too). Each step:
 1. every pilot chooses from its aircraft's observation (and the opponent states); the choice
    is clipped to the action contract (``envs.actions.clip``);
 2. an expert, where given, labels the same observation (else the pilot's choice is the label);
-3. DART noise, where asked, perturbs the surfaces of what is flown (drawn from the seed);
+3. DART noise, where asked, perturbs every control of what is flown (drawn from the seed);
 4. the env steps; what every aircraft really flew, its reward, state and flags are read back
    from the world, so the records hold what JSBSim was given.
 
@@ -128,7 +128,7 @@ class Rollout:
         env: an ``AircraftEnv``, or an ``OfflineEnv``/``OnlineEnv`` (then give ``team``).
         pilots: one Agent per aircraft flown through the env's ``step``.
         experts: a labelling Agent (or None) per pilot.
-        noise: std of Gaussian noise on the executed surfaces (DART); 0 = none.
+        noise: std of Gaussian noise on each executed control, throttle too (DART); 0 = none.
         team: the team the pilots fly, for team envs.
     """
 
@@ -206,7 +206,9 @@ class Rollout:
             action = clean
             if self.noise:
                 action = clean.copy()
-                action[:3] += self._rng.normal(0.0, self.noise, 3)
+                # every control, the throttle too: noise on the surfaces alone never showed
+                # the speed loop at work, and a clone of it left the throttle still in gusts
+                action += self._rng.normal(0.0, self.noise, len(action))
                 action = clip(action)
             if expert is not None:
                 labels[slot.callsign] = clip(expert.act(obs, self._opponents))
