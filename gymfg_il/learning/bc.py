@@ -157,6 +157,7 @@ def _policy(
     rate, flight and camera size) and seeded with ``cfg.seed``, on ``device``."""
     import torch
 
+    from gymfg_il.learning.memory import by_expert
     from gymfg_il.policies.configuration import DatasetInfo
     from gymfg_il.policies.factory import make_policy
 
@@ -165,6 +166,8 @@ def _policy(
     torch.manual_seed(cfg.seed)
     policy = make_policy(config, frames.obs_stats, frames.action_stats).to(device)
     policy.obs_noise = cfg.obs_noise
+    if hasattr(policy, "anchor_memory") and by_expert(frames):
+        policy.anchor_memory()
     return policy
 
 

@@ -28,9 +28,12 @@ class MLPConfig(PolicyConfig):
             integrals). `vertical`: the climb-rate and pitch loops (what holds an
             altitude); `loops`: every loop (also roll, airspeed, slip); `none`: the
             observation alone; `auto`: what the task asks for (`Task.memory`):
-            `vertical` for altitude, pitch, turn, climb-turn, waypoints and approach,
+            `vertical` for altitude, pitch, turn, climb-turn, waypoints and approach
+            (`loops` for the heading and the turn from their autopilot's demonstrations),
             `none` for the tasks that hold their start altitude (roll, heading, airspeed,
             sideslip, level) and formation, or where the dataset is not of one solo flight.
+            From the autopilot's demonstrations the memory starts at, and is held near, the
+            autopilot's own integral terms.
     """
 
     hidden: list[int] = field(default_factory=lambda: [256, 256])

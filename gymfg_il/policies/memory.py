@@ -8,7 +8,9 @@ error and the pitch error, a person by trimming. The task declares its expert's 
 whose action is thrown away) on the policy's own observations and gives their integrals, one
 number per loop, updated in O(1) per step and reset at each episode's start. Training computes
 them over each recorded episode in order (``over``), flight step by step (``__call__``): the
-same code on the same float32 observations, so both see the same numbers."""
+same code on the same float32 observations, so both see the same numbers. Where the expert
+itself demonstrated, its integral terms (``LoopMemory.expert_gains``) are what a policy's
+memory starts from and is held near (``learning.memory.by_expert``)."""
 
 from __future__ import annotations
 
@@ -62,6 +64,7 @@ class LoopMemoryRecipe:
     gains: Any
     throttle: float
     default: str = "none"  # what the task remembers by default (``Task.memory``)
+    by_expert: str = "none"  # ... from its own expert's demonstrations
 
     @classmethod
     def for_flight(
@@ -83,10 +86,10 @@ class LoopMemoryRecipe:
                 )
             model, dt = env.aircraft.model, env.dt
             pilot = controller_for(env.task, model, dt, env.aircraft.profile.cruise_throttle)
-            default = env.task.memory()
+            defaults = (env.task.memory(), env.task.memory(by_expert=True))
         finally:
             env.close()
-        return cls(names, model, dt, pilot.targets, pilot.gains, pilot.throttle_trim, default)
+        return cls(names, model, dt, pilot.targets, pilot.gains, pilot.throttle_trim, *defaults)
 
     def new(self, kind: str = "loops") -> LoopMemory:
         from gymfg_il.controllers.autopilot import Autopilot
@@ -116,6 +119,34 @@ class LoopMemory:
             [(p.out_max - p.out_min) / abs(p.ki) if p.ki else 0.0 for p in self.pids],
             dtype=np.float32,
         )
+
+    @property
+    def scales(self) -> np.ndarray:
+        """What each integral is measured in as a policy's input: its loop's range
+        (``bounds``; 1 for a loop without an integral term). Not the data's spread: still-air
+        demonstrations barely move the integrals of the loops that only hold a start value,
+        and an input divided by that spread reached a hundred times it in a gust."""
+        bounds = self.bounds
+        return np.where(bounds > 0, bounds, 1.0).astype(np.float32)
+
+    def expert_gains(self) -> np.ndarray:
+        """How the expert's action (aileron, elevator, rudder, throttle) moves per unit of
+        each integral, (4, loops), while no loop is saturated: its integral term, through
+        the pitch loop for the climb-rate loop's (whose integral sets a pitch target that the
+        pitch loop's gain and its integral, within the step, answer). What a policy's memory
+        starts from and is held near where the data says little."""
+        gains = np.zeros((4, len(self.pids)), np.float32)
+        pitch = self.pilot.pitch_pid
+        through_pitch = pitch.kp + pitch.ki * self.pilot.dt
+        along = {"climb": (1, -through_pitch), "pitch": (1, -1.0), "roll": (0, 1.0)}
+        along |= {"speed": (3, 1.0), "slip": (2, 1.0)}
+        for k, (name, pid) in enumerate(zip(self.names, self.pids, strict=True)):
+            loop = name.removeprefix("memory.").removesuffix("_error_integral")
+            axis, factor = along[loop]
+            if loop == "slip" and self.pilot.targets.sideslip_source is None:
+                continue  # coordinated flight: the rudder reads the slip alone, no integral
+            gains[axis, k] = factor * pid.ki
+        return gains
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         """The integrals once ``observation`` (float32, the policy's) is taken in."""

@@ -14,6 +14,11 @@ from torch import nn
 from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.policies.normalize import NormalizedPolicy, OneThread
 
+# how firmly training holds the memory's layer at the expert's integral terms: a squared
+# distance of 100 (normalised units; the terms are 10-80) costs what a mean squared action
+# error of 1 does
+MEMORY_PULL = 0.01
+
 
 class MLPPolicy(NormalizedPolicy):
     def __init__(
@@ -41,6 +46,7 @@ class MLPPolicy(NormalizedPolicy):
         layers.append(nn.Linear(width, n_act))
         self.net = nn.Sequential(*layers)
         self._recipe: Any = None  # what makes the memory of a new episode, built once
+        self._anchor: tuple[torch.Tensor, float] | None = None  # the memory's prior, training
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         """Normalised action predicted from raw observations (any leading dims); with
@@ -56,7 +62,28 @@ class MLPPolicy(NormalizedPolicy):
         return self.net(x[..., :-k]) + self.integral(x[..., -k:])
 
     def loss(self, obs: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
-        return nn.functional.mse_loss(self.forward(obs), self.action_norm(action))
+        loss = nn.functional.mse_loss(self.forward(obs), self.action_norm(action))
+        if self._anchor is not None and self.training and self.integral is not None:
+            prior, pull = self._anchor
+            loss = loss + pull * (self.integral.weight - prior).square().sum()
+        return loss
+
+    def anchor_memory(self, pull: float = MEMORY_PULL) -> None:
+        """Start the memory's layer at the expert's integral terms (``LoopMemory.
+        expert_gains`` in this policy's normalised units) and, while training, hold it near
+        them with ``pull`` times the squared distance: where the demonstrations move an
+        integral the data decides, where they barely move it (a loop that only holds its
+        start value in still air) the clone answers a gust as the expert's loop would."""
+        if self.integral is None or self.n_act != 4:
+            return
+        memory = self.recipe().new(self.config.memory)
+        gains = memory.expert_gains() * memory.scales[None, :]
+        std = self.action_norm.std.detach().cpu().numpy().reshape(-1, 1)
+        weight = self.integral.weight
+        prior = torch.as_tensor(gains / std, dtype=weight.dtype, device=weight.device)
+        with torch.no_grad():
+            weight.copy_(prior)
+        self._anchor = (prior, pull)
 
     @torch.no_grad()
     def act(self, obs: torch.Tensor, state: Any = None) -> tuple[torch.Tensor, Any]:

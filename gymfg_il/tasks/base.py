@@ -88,6 +88,9 @@ class Task:
     episode_time_s: ClassVar[float] = 90.0
     # what the window shows beyond the primary instruments (``guidance_lines``)
     guidance: ClassVar[tuple[Line, ...] | None] = None
+    # what a policy cloned from this task's own expert remembers (``memory``); None: what a
+    # clone of anyone's demonstrations does
+    expert_memory: ClassVar[str | None] = None
 
     @classmethod
     def episode_time_for(cls, profile: FlightProfile) -> float:
@@ -237,12 +240,17 @@ class Task:
         ``controllers.autopilot.controller_for`` builds; None: the task has none."""
         return None
 
-    def memory(self) -> str:
+    def memory(self, by_expert: bool = False) -> str:
         """What a policy cloned for this task remembers by default (``train bc --memory
         auto``; ``policies.memory``): `vertical` (its expert's climb-rate and pitch loop
         integrals) where the expert's vertical loop follows a target the task observes,
         `none` where it holds the start altitude (the demonstrations then barely move those
-        integrals, and a clone's weights on them are guesses: docs/results/memory.md)."""
+        integrals, and a clone's weights on them are guesses: docs/results/memory.md).
+        ``by_expert``: for demonstrations this task's own expert flew (``collect
+        autopilot``), whose integral terms the memory starts from and is held near; a task
+        may remember more then (``expert_memory``)."""
+        if by_expert and self.expert_memory is not None:
+            return self.expert_memory
         expert = self.expert()
         followed = expert is not None and isinstance(expert.targets.vertical_source, str)
         return "vertical" if followed else "none"

@@ -119,7 +119,7 @@ class FormationTask(ManeuverTask):
     tolerance_ft = 100.0
     min_separation_ft = 50.0
 
-    def memory(self) -> str:
+    def memory(self, by_expert: bool = False) -> str:
         """None: the slot moves with the lead, and from five demonstrations a clone with
         the vertical loops' integrals held it 69 % of the time, one without 100 %
         (docs/results/memory.md)."""

@@ -135,3 +135,89 @@ def test_the_vertical_loops_alone_integrate_as_the_whole_autopilot_does(tiny_dat
     alone = recipe.new("vertical")
     assert alone.vertical_only and not recipe.new("loops").vertical_only
     assert np.array_equal(alone.over(obs), whole)
+
+
+def test_the_expert_gains_are_how_the_experts_action_moves_with_each_integral(tiny_dataset):
+    frames = load_frames(tiny_dataset)
+    spec, _ = frames.flight()
+    recipe = LoopMemoryRecipe.for_flight(spec.to_dict(), frames.observation_names)
+    obs = frames.obs[frames.episode == frames.episode[0]]
+    memory = recipe.new("loops")
+    gains = memory.expert_gains()
+    assert gains.shape == (4, len(NAMES)) and np.count_nonzero(gains) == 4  # no slip target
+    for k, pid in enumerate(memory.pids):
+        if not gains[:, k].any():
+            continue
+        moved = []
+        for nudge in (0.0, 0.5):  # the same steps, one integral set a little further
+            memory.reset()
+            for row in obs[:20]:
+                memory(row)
+            pid.integral += nudge
+            moved.append(memory.pilot.act(obs[20]))
+        # measured on the expert itself, unsaturated: its action moves by the gain times it
+        assert np.allclose((moved[1] - moved[0]) / 0.5, gains[:, k], atol=1e-6), (k, moved)
+
+
+def test_training_starts_the_memory_at_the_expert_and_holds_it_there(remembering):
+    """The still-air data barely moves the integrals, so the layer they reach the action
+    through stays where it starts: the expert's integral terms, in normalised units."""
+    from gymfg_il.policies.checkpoint import load_policy
+
+    policy, _ = load_policy(remembering)
+    memory = policy.recipe().new("loops")
+    std = policy.action_norm.std.numpy().reshape(-1, 1)
+    expert = memory.expert_gains() * memory.scales[None, :] / std
+    learned = policy.integral.weight.detach().numpy()
+    assert np.abs(expert).max() > 5  # terms that a layer started at zero would not reach
+    assert np.allclose(learned, expert, atol=0.05 * np.abs(expert).max())
+    assert np.allclose(policy.obs_norm.std.numpy()[-len(NAMES) :], memory.scales)
+
+
+def test_anyone_elses_memory_is_learned_from_the_data(tiny_dataset, tmp_path):
+    """A person's trim is not the expert's integral: the same frames said to be a synthetic
+    pilot's give a memory measured in its spread in the data, and a layer that starts from
+    nothing rather than from the expert's terms."""
+    from gymfg_il.policies.checkpoint import load_policy
+
+    frames = load_frames(tiny_dataset)
+    frames.episodes["gymfg/source"] = ["synthetic"] * len(frames.episodes["gymfg/source"])
+    spread = remembered(frames, MLPConfig(memory="loops")).obs[:, -len(NAMES) :].std(0)
+    out = tmp_path / "policy"
+    cfg = TrainConfig(
+        dataset=tiny_dataset, out=out, epochs=3, policy=MLPConfig(hidden=[32], memory="loops")
+    )
+    train_bc(cfg, frames=frames)
+    policy, _ = load_policy(out)
+    spread = np.where(spread > 0, spread, 1.0)  # the slip loop's: none (the normaliser's 1)
+    assert np.allclose(policy.obs_norm.std.numpy()[-len(NAMES) :], spread, rtol=1e-5)
+    assert np.abs(policy.integral.weight.detach().numpy()).max() < 5  # expert's: up to ~80
+
+
+@pytest.mark.parametrize(
+    ("task", "anyone", "expert"),
+    [
+        ("altitude", "vertical", "vertical"),
+        ("heading", "none", "loops"),
+        ("heading dynamic", "none", "none"),
+        ("roll", "none", "none"),
+        ("turn", "vertical", "loops"),
+        ("approach", "vertical", "vertical"),
+        ("formation", "none", "none"),
+    ],
+)
+def test_each_task_says_what_its_clones_remember_by_demonstrator(task, anyone, expert):
+    name, *dynamic = task.split()
+    env = (
+        FlightSpec.solo(task=name, dynamic=bool(dynamic)).make_env()
+        if name != "formation"
+        else None
+    )
+    if env is None:
+        from gymfg_il.tasks.formation import FormationTask
+
+        chosen = (FormationTask().memory(), FormationTask().memory(by_expert=True))
+    else:
+        chosen = (env.task.memory(), env.task.memory(by_expert=True))
+        env.close()
+    assert chosen == (anyone, expert)
