@@ -61,15 +61,20 @@ def remembered(frames: Frames, policy: Any) -> Frames:
     return replace(frames, obs=obs, observation_names=names, obs_stats=stats)
 
 
+# sources whose every action is the task's own autopilot's: its demonstrations, and the states
+# a policy flew into, labelled by it (``collect dagger``)
+BY_EXPERT = ("autopilot", "dagger")
+
+
 def by_expert(frames: Frames) -> bool:
-    """Whether the task's own expert flew every episode of ``frames`` (``collect
-    autopilot``): then the memory's loops are the demonstrator's, whose integral terms are
+    """Whether the task's own expert gave every action of ``frames`` (``collect autopilot``,
+    ``collect dagger``): then the memory's loops are the demonstrator's, whose integral terms are
     known, and a policy starts from them and is held near them (``MLPPolicy.anchor_memory``),
     each integral measured in its loop's range. Anyone else's integrals (a person's trim)
     are learned from the data, measured in their spread there: held at the expert's terms,
     a clone of the synthetic pilot's turns flew 19 % against 100 % (docs/results/memory.md)."""
     sources = frames.episodes.get("gymfg/source") or []
-    return bool(sources) and all(source == "autopilot" for source in sources)
+    return bool(sources) and all(source in BY_EXPERT for source in sources)
 
 
 def _columns(frames: Frames, fresh: Any) -> np.ndarray:

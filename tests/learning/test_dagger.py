@@ -11,6 +11,7 @@ from gymfg_il.learning.bc import train_bc
 from gymfg_il.learning.config import TrainConfig
 from gymfg_il.learning.dagger import run_dagger
 from gymfg_il.learning.data import load_frames
+from gymfg_il.policies.configuration_mlp import MLPConfig
 from gymfg_il.rollout import AgentSpec, fly_many
 
 
@@ -18,7 +19,12 @@ from gymfg_il.rollout import AgentSpec, fly_many
 def test_dagger_beats_plain_bc(tmp_path):
     # two clean demonstrations: BC never sees how to recover from its own deviations
     demo = CollectConfig(
-        task="heading", episodes=2, episode_time_s=40, seed=1000, out=tmp_path / "demo"
+        task="heading",
+        episodes=2,
+        episode_time_s=40,
+        seed=1000,
+        noise=0.0,
+        out=tmp_path / "demo",
     )
     build_from_logs([record_autopilot(demo).log], tmp_path / "demo" / "dataset")
     bc = train_bc(
@@ -28,6 +34,7 @@ def test_dagger_beats_plain_bc(tmp_path):
             epochs=40,
             val_fraction=0.0,
             seed=0,
+            policy=MLPConfig(memory="none"),  # DAgger's own gain, not the memory's
         )
     )
     history = run_dagger(

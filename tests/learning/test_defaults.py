@@ -48,3 +48,7 @@ def test_train_says_when_validation_loss_is_far_above_training_loss(tmp_path):
     assert result(0.0255, 0.2587).overfit == ""
     assert result(0.0167, 0.3363).overfit == ""  # the same with the trim in the controls: 20x
     assert result(0.0001, 0.0004).overfit == ""  # both tiny: nothing worth a warning
+    # every demonstration flown with DART noise: the remedy is there already (roll from 20,
+    # with the throttle noised, read 60x and flew every held-out episode)
+    noised = TrainResult(tmp_path, [0.5, 0.0544], [0.5, 3.2428], 1.0, 100, {}, noised=True)
+    assert noised.overfit == "" and "59.6x" in result(0.0544, 3.2428).overfit

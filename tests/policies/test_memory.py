@@ -221,3 +221,14 @@ def test_each_task_says_what_its_clones_remember_by_demonstrator(task, anyone, e
         chosen = (env.task.memory(), env.task.memory(by_expert=True))
         env.close()
     assert chosen == (anyone, expert)
+
+
+def test_the_expert_labels_the_autopilots_demonstrations_and_daggers_rounds(tiny_dataset):
+    from gymfg_il.learning.memory import by_expert
+
+    frames = load_frames(tiny_dataset)
+    n = len(frames.episodes["gymfg/source"])
+    assert by_expert(frames)
+    for sources, expert in ((["dagger"] * n, True), (["autopilot"] * (n - 1) + ["human"], False)):
+        frames.episodes["gymfg/source"] = sources
+        assert by_expert(frames) is expert, sources
