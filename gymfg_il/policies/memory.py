@@ -104,6 +104,7 @@ class LoopMemory:
 
     def __init__(self, pilot: Any, loops: Sequence[str] = LOOPS["loops"]) -> None:
         self.pilot = pilot
+        self.loops = tuple(loops)
         self.pids = tuple(getattr(pilot, f"{loop}_pid") for loop in loops)
         self.names = feature_names(loops)
         self.vertical_only = set(loops) <= {"climb", "pitch"}
@@ -140,8 +141,7 @@ class LoopMemory:
         through_pitch = pitch.kp + pitch.ki * self.pilot.dt
         along = {"climb": (1, -through_pitch), "pitch": (1, -1.0), "roll": (0, 1.0)}
         along |= {"speed": (3, 1.0), "slip": (2, 1.0)}
-        for k, (name, pid) in enumerate(zip(self.names, self.pids, strict=True)):
-            loop = name.removeprefix("memory.").removesuffix("_error_integral")
+        for k, (loop, pid) in enumerate(zip(self.loops, self.pids, strict=True)):
             axis, factor = along[loop]
             if loop == "slip" and self.pilot.targets.sideslip_source is None:
                 continue  # coordinated flight: the rudder reads the slip alone, no integral

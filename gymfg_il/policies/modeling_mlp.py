@@ -77,11 +77,14 @@ class MLPPolicy(NormalizedPolicy):
         the data says beyond those terms is the network's to learn."""
         if self.integral is None or self.n_act != 4:
             return
-        memory = self.recipe().new(self.config.memory)
-        gains = memory.expert_gains() * memory.scales[None, :]
-        std = self.action_norm.std.detach().cpu().numpy().reshape(-1, 1)
+        gains = self.recipe().new(self.config.memory).expert_gains()
+        # in this policy's own units: each integral as its normaliser reads it, per action std
+        memory_std = self.obs_norm.std.detach().cpu().numpy()[-self.n_memory :]
+        action_std = self.action_norm.std.detach().cpu().numpy().reshape(-1, 1)
         weight = self.integral.weight
-        prior = torch.as_tensor(gains / std, dtype=weight.dtype, device=weight.device)
+        prior = torch.as_tensor(
+            gains * memory_std[None, :] / action_std, dtype=weight.dtype, device=weight.device
+        )
         with torch.no_grad():
             weight.copy_(prior)
         self._anchor = (prior, pull)
