@@ -91,8 +91,15 @@ class Autopilot:
         self._last_altitude_target: float | None = None
         self.throttle_trim = 0.7
         self.rudder_trim = 0.0
-        self._observed = self._observed_integrals()
+        self._observed = self._integrals_in_observation()
         self._from_observation: dict[str, int] = {}
+
+    @property
+    def observed_integrals(self) -> dict[str, int]:
+        """Loop -> index of the observation entry that itself carries its error integral
+        (the roll task's ``roll_deg_error_integral``, the approach's
+        ``airspeed_kts_error_integral``, ...)."""
+        return dict(self._observed)
 
     def reset(self, seed: int | None = None) -> None:
         for pid in (self.pitch_pid, self.roll_pid, self.climb_pid, self.speed_pid, self.slip_pid):
@@ -124,7 +131,7 @@ class Autopilot:
         if "speed" not in observed:
             self.speed_pid.track(float(applied[3]))
 
-    def _observed_integrals(self) -> dict[str, int]:
+    def _integrals_in_observation(self) -> dict[str, int]:
         """Loop -> index of the observation entry holding its error integral."""
         t, index = self.targets, self.index
         out = {}

@@ -77,7 +77,8 @@ class MLPPolicy(NormalizedPolicy):
         the data says beyond those terms is the network's to learn."""
         if self.integral is None or self.n_act != 4:
             return
-        gains = self.recipe().new(self.config.memory).expert_gains()
+        memory = self.recipe().new(self.config.memory)
+        gains = memory.expert_gains()
         # in this policy's own units: each integral as its normaliser reads it, per action std
         memory_std = self.obs_norm.std.detach().cpu().numpy()[-self.n_memory :]
         action_std = self.action_norm.std.detach().cpu().numpy().reshape(-1, 1)
@@ -88,6 +89,21 @@ class MLPPolicy(NormalizedPolicy):
         with torch.no_grad():
             weight.copy_(prior)
         self._anchor = (prior, pull)
+        # a remembered loop whose integral the observation also carries (the approach's
+        # airspeed): the network does not read that copy, its first layer's column held at
+        # zero, so the integral reaches the action through the expert's term alone. Reading
+        # both, the network learned to more than cancel the term through the copy (clamped
+        # at another range): the f15's clones flew the approach 57-65 kt fast, the throttle
+        # rising as the speed grew; without the term, gusts undid the c172p's approach
+        copies = [i for loop, i in memory.pilot.observed_integrals.items() if loop in memory.loops]
+        if copies:
+            first = self.net[0]
+            assert isinstance(first, nn.Linear)
+            keep = torch.ones_like(first.weight)
+            keep[:, copies] = 0.0
+            with torch.no_grad():
+                first.weight.mul_(keep)
+            first.weight.register_hook(lambda grad: grad * keep)
 
     @torch.no_grad()
     def act(self, obs: torch.Tensor, state: Any = None) -> tuple[torch.Tensor, Any]:
