@@ -238,6 +238,7 @@ def test_anyone_elses_memory_is_learned_from_the_data(tiny_dataset, tmp_path):
         ("heading dynamic", "none", "none"),
         ("roll", "none", "none"),
         ("turn", "vertical", "loops"),
+        ("climb-turn", "vertical", "loops"),
         ("approach", "vertical", "loops"),
         ("formation", "none", "none"),
     ],
