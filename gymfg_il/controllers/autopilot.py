@@ -96,9 +96,9 @@ class Autopilot:
 
     @property
     def observed_integrals(self) -> dict[str, int]:
-        """Loop -> index of the observation entry that itself carries its error integral
-        (the roll task's ``roll_deg_error_integral``, the approach's
-        ``airspeed_kts_error_integral``, ...)."""
+        """Loop -> index of the observation entry that sums the same error (the roll task's
+        ``roll_deg_error_integral``, the approach's ``airspeed_kts_error_integral``, ...):
+        the task's own sum, which keeps summing where the loop's anti-windup stops."""
         return dict(self._observed)
 
     def reset(self, seed: int | None = None) -> None:
@@ -121,8 +121,15 @@ class Autopilot:
         integral from the observation at each later ``act`` instead, so the label is a
         function of the observation alone, which is what a memoryless policy can learn.
         Back-calculating it from the policy's own action would make the label depend on
-        that action, which the policy never sees."""
-        observed = self._observed if from_observation else {}
+        that action, which the policy never sees. Not the airspeed's: the task's sum goes on
+        while the throttle sits at a limit (idle on a descent, routinely), where the loop's
+        stops, and loaded into the loop a wound-up sum held the labels' throttle at idle
+        through whole approaches; the speed loop follows what is flown instead."""
+        observed = (
+            {loop: at for loop, at in self._observed.items() if loop != "speed"}
+            if from_observation
+            else {}
+        )
         self._from_observation = observed
         if "roll" not in observed:
             self.roll_pid.track(float(applied[0]))

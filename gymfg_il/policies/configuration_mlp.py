@@ -29,7 +29,8 @@ class MLPConfig(PolicyConfig):
             altitude); `loops`: every loop (also roll, airspeed, slip); `none`: the
             observation alone; `auto`: what the task asks for (`Task.memory`):
             `vertical` for altitude, pitch, turn, climb-turn, waypoints and approach
-            (`loops` for the heading and the turn from their autopilot's demonstrations),
+            (`loops` for the heading, the turn, the climb-turn and the approach from their
+            autopilot's demonstrations),
             `none` for the tasks that hold their start altitude (roll, heading, airspeed,
             sideslip, level) and formation, or where the dataset is not of one solo flight.
             From the autopilot's demonstrations the memory starts at, and is held near, the

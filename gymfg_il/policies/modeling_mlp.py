@@ -74,7 +74,9 @@ class MLPPolicy(NormalizedPolicy):
         with ``pull`` times the squared distance (in the runs measured it moved by less than
         0.1 %): an integral the demonstrations barely moved (a loop that only holds its
         start value in still air) then answers a gust as the expert's loop would, and what
-        the data says beyond those terms is the network's to learn."""
+        the data says beyond those terms is the network's to learn. Where the observation
+        also sums a remembered loop's error, the network does not read that entry (below).
+        Only ``train bc`` holds it so: ``train ppo`` fine-tunes every weight."""
         if self.integral is None or self.n_act != 4:
             return
         memory = self.recipe().new(self.config.memory)
@@ -89,12 +91,13 @@ class MLPPolicy(NormalizedPolicy):
         with torch.no_grad():
             weight.copy_(prior)
         self._anchor = (prior, pull)
-        # a remembered loop whose integral the observation also carries (the approach's
-        # airspeed): the network does not read that copy, its first layer's column held at
-        # zero, so the integral reaches the action through the expert's term alone. Reading
-        # both, the network learned to more than cancel the term through the copy (clamped
-        # at another range): the f15's clones flew the approach 57-65 kt fast, the throttle
-        # rising as the speed grew; without the term, gusts undid the c172p's approach
+        # a remembered loop whose error the observation also sums (the approach's airspeed,
+        # its own sum, which winds up where the loop's anti-windup stops): the network does
+        # not read that sum, its first layer's column held at zero, so the integral reaches
+        # the action through the expert's term alone. Reading both, the network learned to
+        # more than cancel the term through the task's sum: the f15's clones flew the
+        # approach 57-65 kt fast, the throttle rising as the speed grew; without the term,
+        # gusts undid the c172p's approach
         copies = [i for loop, i in memory.pilot.observed_integrals.items() if loop in memory.loops]
         if copies:
             first = self.net[0]

@@ -91,6 +91,34 @@ def test_labels_from_the_observed_integral_depend_on_the_observation_alone():
     assert bumpless[1] - bumpless[0] == pytest.approx(0.8, abs=1e-6)
 
 
+def test_dagger_labels_keep_the_speed_loop_its_own_integral():
+    """The approach's airspeed integral goes on summing while the throttle sits at idle,
+    where the speed loop's anti-windup stops: labelling as ``collect dagger`` does, the
+    labeller's throttle follows the pilot's (a second autopilot, DART-noised) instead of a
+    wound-up sum that held it at idle through the whole approach."""
+    env = AircraftEnv("approach", "c172p")
+    rng = np.random.default_rng(0)
+    obs, _ = env.reset(seed=3)
+    pilot = controller_for(env.task, "c172p", env.dt, env.aircraft.profile.cruise_throttle)
+    labeller = controller_for(env.task, "c172p", env.dt, env.aircraft.profile.cruise_throttle)
+    pilot.reset(3)
+    labeller.reset(3)
+    gaps, wound = [], []
+    summed = list(env.task.observation_names).index("airspeed_kts_error_integral")
+    for step in range(1200):
+        clean = np.clip(pilot.act(obs), [-1, -1, -1, 0], 1)
+        label = np.clip(labeller.act(obs), [-1, -1, -1, 0], 1)
+        flown = np.clip(clean + rng.normal(0.0, 0.05, 4), [-1, -1, -1, 0], 1)
+        labeller.track(flown, from_observation=True)
+        if step >= 300:
+            gaps.append(abs(label[3] - clean[3]))
+            wound.append(abs(obs[summed]) > 1.5 * abs(labeller.speed_pid.integral) + 50)
+        obs, *_ = env.step(flown)
+    env.close()
+    assert np.mean(wound) > 0.5  # the task's sum and the loop's integral did part
+    assert np.median(gaps) < 0.1
+
+
 @pytest.mark.parametrize("model", ["c172p", "f15", "A320"])
 @pytest.mark.parametrize("target", [4.0, -4.0])
 def test_the_rudder_holds_a_sideslip_target(model, target):

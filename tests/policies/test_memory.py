@@ -15,7 +15,7 @@ from gymfg_il.learning.memory import remembered
 from gymfg_il.policies.agent import PolicyAgent
 from gymfg_il.policies.configuration import DatasetInfo
 from gymfg_il.policies.configuration_mlp import MLPConfig
-from gymfg_il.policies.memory import NAMES, LoopMemoryRecipe, names_of
+from gymfg_il.policies.memory import LOOPS, NAMES, LoopMemoryRecipe, names_of
 from gymfg_il.rollout import Rollout
 
 
@@ -159,18 +159,26 @@ def test_the_expert_gains_are_how_the_experts_action_moves_with_each_integral(ti
         assert np.allclose((moved[1] - moved[0]) / 0.5, gains[:, k], atol=1e-6), (k, moved)
 
 
-def test_a_remembered_integral_the_observation_also_carries_is_read_once(tmp_path):
-    """The pitch task observes its pitch error's integral, which the memory's pitch loop
-    also holds: a clone of the autopilot reads it through the expert's term alone, the
-    network's column of the observed copy held at zero through training (reading both, the
-    f15's approach clones cancelled the term through the copy and flew 57-65 kt fast)."""
+@pytest.mark.parametrize(
+    ("task", "loops", "summed"),
+    [
+        ("pitch", ("climb", "pitch"), {"pitch": "pitch_deg_error_integral"}),
+        ("approach", LOOPS["loops"], {"speed": "airspeed_kts_error_integral"}),
+    ],
+)
+def test_a_remembered_error_the_observation_also_sums_is_read_once(tmp_path, task, loops, summed):
+    """The pitch task sums its pitch error, the approach its airspeed error, which the
+    memory's loops also integrate: a clone of the autopilot reads them through the expert's
+    terms alone, the network's column of the task's sum held at zero through training, so
+    the action does not move with it (reading both, the f15's approach clones cancelled the
+    term through the sum and flew 57-65 kt fast)."""
     from gymfg_il.collectors.autopilot import record_autopilot
     from gymfg_il.collectors.config import CollectConfig
     from gymfg_il.datasets.from_logs import build_from_logs
     from gymfg_il.policies.checkpoint import load_policy
 
     cfg = CollectConfig(
-        task="pitch", episodes=3, episode_time_s=20, noise=0.05, seed=1000, out=tmp_path
+        task=task, episodes=2, episode_time_s=20, noise=0.05, seed=1000, out=tmp_path
     )
     build_from_logs([record_autopilot(cfg).log], tmp_path / "dataset")
     out = tmp_path / "policy"
@@ -181,18 +189,24 @@ def test_a_remembered_integral_the_observation_also_carries_is_read_once(tmp_pat
     policy, meta = load_policy(out)
     names = meta["observation_names"]
     memory = policy.recipe().new(policy.config.memory)
-    assert memory.loops == ("climb", "pitch")
-    assert memory.pilot.observed_integrals == {"pitch": names.index("pitch_deg_error_integral")}
+    assert memory.loops == loops
+    assert memory.pilot.observed_integrals == {k: names.index(v) for k, v in summed.items()}
+    ((loop, name),) = summed.items()
     first = policy.net[0].weight.detach().numpy()
-    copy = names.index("pitch_deg_error_integral")
-    assert not first[:, copy].any()
-    assert np.abs(first[:, names.index("pitch_deg_error")]).min() > 0  # the rest learned
+    assert not first[:, names.index(name)].any()
+    assert np.abs(first[:, names.index(name.removesuffix("_integral"))]).min() > 0  # learned
     std = policy.action_norm.std.numpy().reshape(-1, 1)
     expert = memory.expert_gains() * memory.scales[None, :] / std
-    assert np.abs(expert[:, 1]).max() > 1  # the pitch loop's term, the one copy read
-    assert np.allclose(
-        policy.integral.weight.detach().numpy(), expert, atol=0.05 * np.abs(expert).max()
-    )
+    assert np.abs(expert[:, loops.index(loop)]).max() > 1  # the loop's term: the one read
+    learned = policy.integral.weight.detach().numpy()
+    assert np.allclose(learned, expert, atol=0.05 * np.abs(expert).max())
+    policy.eval()
+    frames = load_frames(tmp_path / "dataset")
+    row = frames.obs[50]
+    moved = row.copy()
+    moved[names.index(name)] += 500.0
+    same = [policy.step(x)[0] for x in (row, moved)]
+    assert np.array_equal(same[0], same[1])
 
 
 def test_training_starts_the_memory_at_the_expert_and_holds_it_there(remembering):
