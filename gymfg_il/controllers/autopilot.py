@@ -137,6 +137,8 @@ class Autopilot:
             self.pitch_pid.track(-float(applied[1]))
         if "speed" not in observed:
             self.speed_pid.track(float(applied[3]))
+        if "slip" not in observed:  # a no-op in coordinated flight: the loop never ran
+            self.slip_pid.track(float(applied[2]))
 
     def _integrals_in_observation(self) -> dict[str, int]:
         """Loop -> index of the observation entry holding its error integral."""
@@ -148,6 +150,8 @@ class Autopilot:
             out["pitch"] = index["pitch_deg_error_integral"]
         if isinstance(t.speed_source, str) and "airspeed_kts_error_integral" in index:
             out["speed"] = index["airspeed_kts_error_integral"]
+        if t.sideslip_source is not None and "beta_deg_error_integral" in index:
+            out["slip"] = index["beta_deg_error_integral"]
         return out
 
     def _load_integral(self, loop: str, pid: PID, obs: list[float], error: float) -> None:
@@ -274,6 +278,7 @@ class Autopilot:
         if t.sideslip_source is None:
             return max(-1.0, min(1.0, self.rudder_trim - self.gains.sideslip * obs[i["beta_deg"]]))
         slip_target = self._value(obs, t.sideslip_source, "beta_deg")  # more rudder, more slip
+        self._load_integral("slip", self.slip_pid, obs, slip_target - obs[i["beta_deg"]])
         return float(self.slip_pid(slip_target, obs[i["beta_deg"]], self.dt))
 
 

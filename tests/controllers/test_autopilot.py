@@ -71,22 +71,29 @@ def test_pid_anti_windup_and_derivative_on_measurement():
         PID(1.0, out_min=1, out_max=0)
 
 
-def test_labels_from_the_observed_integral_depend_on_the_observation_alone():
-    """Under DAgger the expert's roll loop reads its integral from the observation: two
-    experts that tracked different actions label the same observation alike; a plain track
-    (a human's takeover) keeps the hand-back bumpless instead."""
-    env = AircraftEnv("roll", "c172p", task_kwargs={"target": 20})
+@pytest.mark.parametrize(("task", "target", "axis"), [("roll", 20, 0), ("sideslip", 4, 2)])
+def test_labels_from_the_observed_integral_depend_on_the_observation_alone(task, target, axis):
+    """Under DAgger the expert's roll (or slip) loop reads its integral from the
+    observation: two experts that tracked different actions label the same observation
+    alike; a plain track (a human's takeover) keeps the hand-back bumpless instead."""
+    env = AircraftEnv(task, "c172p", task_kwargs={"target": target})
     obs, _ = env.reset(seed=0)
     nxt, *_ = env.step(np.array([0.1, 0.0, 0.0, 0.7]))
     env.close()
+    summed = {"roll": "roll_deg_error_integral", "sideslip": "beta_deg_error_integral"}[task]
+    loop = {"roll": "roll", "sideslip": "slip"}[task]
     labels, bumpless = [], []
     for applied in (-0.4, 0.4):
         for from_observation, out in ((True, labels), (False, bumpless)):
             pilot = controller_for(env.task, "c172p", env.dt, 0.7)
+            names = list(env.task.observation_names)
+            assert pilot.observed_integrals == {loop: names.index(summed)}
             pilot.reset(0)
             pilot.act(obs)
-            pilot.track(np.array([applied, 0.0, 0.0, 0.7]), from_observation=from_observation)
-            out.append(pilot.act(nxt)[0])
+            action = np.array([0.0, 0.0, 0.0, 0.7])
+            action[axis] = applied
+            pilot.track(action, from_observation=from_observation)
+            out.append(pilot.act(nxt)[axis])
     assert labels[0] == pytest.approx(labels[1], abs=1e-9)
     assert bumpless[1] - bumpless[0] == pytest.approx(0.8, abs=1e-6)
 
