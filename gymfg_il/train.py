@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from gymfg_il.envs.flight import FlightSpec
     from gymfg_il.rl.config import PPORunConfig
+    from gymfg_il.rl.saving import PPOResult
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -129,13 +130,7 @@ def _ppo(args: argparse.Namespace) -> int:
 
     result = train_ppo(cfg, on_steps=bar.update, on_eval=on_eval, start=start)
     bar.close()
-    first, last, expert = result.curve[0], result.curve[-1], result.controller
-    print(
-        f"trained {result.out.name} for {result.steps:,} env steps in {duration(result.seconds)}"
-        f": success {100 * first.success:.0f}% -> {100 * last.success:.0f}% (controller "
-        f"{100 * expert.success:.0f}%), return {first.mean_return:.1f} -> "
-        f"{last.mean_return:.1f} (controller {expert.mean_return:.1f})"
-    )
+    print(ppo_outcome(result))
     kept = result.kept
     which = "the actor of " + ("the start" if kept.step == 0 else f"step {kept.step:,}")
     print(
@@ -143,6 +138,26 @@ def _ppo(args: argparse.Namespace) -> int:
         f"{kept.chosen_on} evaluation seeds; curve: {result.out / 'curve.png'})"
     )
     return 0
+
+
+def ppo_outcome(result: PPOResult) -> str:
+    """What a ``train ppo`` run reached, in a line: the curve's seeds at the start and for
+    the actor it saved (the kept one, not necessarily the last evaluated), beside the
+    controller on the same seeds; the last evaluation too where it is another actor."""
+    first, last, expert = result.curve[0], result.curve[-1], result.controller
+    saved = next((p for p in result.curve if p.step == result.kept.step), last)
+    tail = ""
+    if saved is not last:
+        tail = (
+            f"; the last evaluation, step {last.step:,}: {100 * last.success:.0f}%, "
+            f"return {last.mean_return:.1f}"
+        )
+    return (
+        f"trained {result.out.name} for {result.steps:,} env steps in {duration(result.seconds)}"
+        f": success {100 * first.success:.0f}% -> {100 * saved.success:.0f}% (the saved actor; "
+        f"controller {100 * expert.success:.0f}%), return {first.mean_return:.1f} -> "
+        f"{saved.mean_return:.1f} (controller {expert.mean_return:.1f}){tail}"
+    )
 
 
 def ppo_plan(cfg: PPORunConfig, flight: FlightSpec) -> str:

@@ -109,3 +109,22 @@ def test_ppos_settings_come_from_the_tasks_table_and_the_flags_win(
     own.write_text(original.replace("epochs = 10", 'epochs = "ten"'))
     with pytest.raises(ConfigError, match=r"epochs='ten': want int"):
         PPORunConfig(init=bc_policy, envs=2)
+
+
+def test_the_closing_line_reports_the_saved_actor_not_the_last_evaluated(tmp_path):
+    """A run that kept its start (no checkpoint beat it) said "success 81% -> 75%", the last
+    evaluation's: the line gives the saved actor's figures, and the last evaluation beside."""
+    from gymfg_il.rl.judge import EvalPoint
+    from gymfg_il.rl.saving import PPOResult
+    from gymfg_il.train import ppo_outcome
+
+    def point(step, success, ret):
+        return EvalPoint(step, success, ret, 0, 0.0, success, ret, 64)
+
+    curve = [point(0, 0.8125, 900.0), point(50_000, 0.5, 700.0), point(100_000, 0.75, 880.0)]
+    kept = PPOResult(tmp_path, 100_000, 60.0, curve, point(0, 0.875, 950.0), [], curve[0])
+    line = ppo_outcome(kept)
+    assert "success 81% -> 81% (the saved actor; controller 88%)" in line
+    assert "900.0 -> 900.0 (controller 950.0); the last evaluation, step 100,000: 75%" in line
+    last = PPOResult(tmp_path, 100_000, 60.0, curve, point(0, 0.875, 950.0), [], curve[-1])
+    assert ppo_outcome(last).endswith("return 900.0 -> 880.0 (controller 950.0)")
