@@ -65,7 +65,8 @@ class MLPPolicy(NormalizedPolicy):
         loss = nn.functional.mse_loss(self.forward(obs), self.action_norm(action))
         if self._anchor is not None and self.training and self.integral is not None:
             prior, pull = self._anchor
-            loss = loss + pull * (self.integral.weight - prior).square().sum()
+            weight = self.integral.weight  # the prior follows the policy to its device
+            loss = loss + pull * (weight - prior.to(weight.device)).square().sum()
         return loss
 
     def anchor_memory(self, pull: float = MEMORY_PULL) -> None:
@@ -106,7 +107,7 @@ class MLPPolicy(NormalizedPolicy):
             keep[:, copies] = 0.0
             with torch.no_grad():
                 first.weight.mul_(keep)
-            first.weight.register_hook(lambda grad: grad * keep)
+            first.weight.register_hook(lambda grad: grad * keep.to(grad.device))
 
     @torch.no_grad()
     def act(self, obs: torch.Tensor, state: Any = None) -> tuple[torch.Tensor, Any]:
