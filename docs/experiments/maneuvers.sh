@@ -4,6 +4,7 @@
 # then 50 synthetic-pilot keyboard demonstrations of turn and waypoints -> an MLP -> eval
 # beside the pilot. About 40 minutes on two cores.
 # Usage: bash docs/experiments/maneuvers.sh [OUT] [EVAL_SEED] [AIRCRAFT] [SEED]
+# Environment: COLLECT (extra collect flags, e.g. "--noise 0.05" for the page's 0.05 rows).
 # (the page's figures: EVAL_SEED 5000, SEED 0 for the expert's demonstrations; the pilot's
 # are always collected from 2000 and evaluated from EVAL_SEED + 1000)
 set -euo pipefail
@@ -14,8 +15,9 @@ AIRCRAFT=${3:-c172p}
 SEED=${4:-0}
 for TASK in turn climb-turn waypoints formation approach; do
   D="$OUT/$TASK-$AIRCRAFT"
+  # shellcheck disable=SC2086
   [ -d "$D/dataset" ] || python -m gymfg_il.collect autopilot --task "$TASK" --aircraft "$AIRCRAFT" \
-    --episodes 50 --seed "$SEED" --out "$D" --no-progress
+    --episodes 50 --seed "$SEED" --out "$D" --no-progress ${COLLECT:-}
   for POLICY in mlp chunk; do
     [ -f "$D-$POLICY/config.json" ] || python -m gymfg_il.train bc --dataset "$D/dataset" \
       --policy "$POLICY" --out "$D-$POLICY" --no-progress

@@ -10,7 +10,7 @@ action from the step's previous action alone, by least squares over every flown 
 controller's own beside it).
 
     python docs/experiments/memory.py OUT [--cases 5-demos gusts pilot] [--tasks altitude heading]
-        [--noise 0.05 0.2] [--variants mlp vertical loops chunk gru] [--episodes 16] [--seed 7000]
+        [--noise 0.05 0.1] [--variants mlp vertical loops chunk gru] [--episodes 16] [--seed 7000]
         [--demo-seed 100]
 
 Variants: `mlp` (no memory), `vertical` (`--memory vertical`: the climb-rate and pitch
@@ -119,7 +119,9 @@ def main() -> None:
     parser.add_argument("out", type=Path, help="folder for the datasets and policies")
     parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
     parser.add_argument("--tasks", nargs="+", default=["altitude", "heading"])
-    parser.add_argument("--noise", nargs="+", type=float, default=[0.05, 0.2])
+    parser.add_argument(
+        "--noise", nargs="+", type=float, default=[0.1], help="DART noise (collect's default)"
+    )
     parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
     parser.add_argument("--episodes", type=int, default=16)
     parser.add_argument("--seed", type=int, default=7000, help="first held-out seed")

@@ -38,7 +38,8 @@ class CollectConfig(FlightOptions):
         noise: autopilot only: DART-style noise: std of Gaussian noise added to each executed
             control, throttle included (the dataset keeps the demonstrator's clean action as
             the label), so the demonstrations show how to recover from small deviations,
-            which behaviour cloning from a controller's demonstrations needs; 0 = none.
+            which behaviour cloning from a controller's demonstrations needs (0.1: in gusts and
+            from few demonstrations it measured best, docs/results/defaults.md); 0 = none.
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
         images: camera views to add to the dataset as LeRobot video features
             ``observation.images.<view>``: ``front`` (the pilot's eye) and/or ``chase``
@@ -49,7 +50,7 @@ class CollectConfig(FlightOptions):
 
     episodes: int = 10
     seed: int = 1000
-    noise: float = 0.05
+    noise: float = 0.1
     out: Path = Path("datasets/autopilot")
     images: list[str] = field(default_factory=list)
     image_size: int = DEFAULT_IMAGE_SIZE

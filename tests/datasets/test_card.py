@@ -53,7 +53,7 @@ def test_a_collected_dataset_has_a_card_naming_what_it_holds(static):
     assert "| cameras | none |" in body
     assert "| starts | trimmed straight, level flight |" in body
     assert "autopilot (2 episodes)" in body and "turbulence light" in body
-    assert "| DART noise (action std) | 0.05 (2 episodes) |" in body  # the default
+    assert "| DART noise (action std) | 0.1 (2 episodes) |" in body  # the default
     names = log.aircraft("ego")["observation_names"]
     for i, name in enumerate(names):
         assert f"| {i} | {name} | {unit_of(name)} |" in body
@@ -83,7 +83,7 @@ def test_the_card_fills_the_templates_blanks_and_says_what_the_data_is_not(stati
     assert f"computed by JSBSim ({log.session['versions']['jsbsim']})" in limits
     assert "`c172p`: JSBSim's own model of that name" in limits
     assert "`autopilot`: GymFG-IL's PID autopilot" in limits and "no person flew" in limits
-    assert "without the DART noise" in limits  # the default 0.05: labels, not what flew
+    assert "without the DART noise" in limits  # the default 0.1: labels, not what flew
     assert "lasts at most 4 s" in limits and "no takeoff, taxiing or landing" in limits
     assert "(lat_deg, lon_deg, altitude_agl_ft, heading_deg," in limits  # not observed
     assert "aileron_cmd" not in limits  # the actions are in the dataset
