@@ -38,8 +38,7 @@ class CollectConfig(FlightOptions):
         noise: autopilot only: DART-style noise: std of Gaussian noise added to each executed
             control, throttle included (the dataset keeps the demonstrator's clean action as
             the label), so the demonstrations show how to recover from small deviations,
-            which behaviour cloning from a controller's demonstrations needs (0.1: in gusts and
-            from few demonstrations it measured best, docs/results/defaults.md); 0 = none.
+            which behaviour cloning from a controller's demonstrations needs; 0 = none.
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
         images: camera views to add to the dataset as LeRobot video features
             ``observation.images.<view>``: ``front`` (the pilot's eye) and/or ``chase``

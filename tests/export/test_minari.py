@@ -128,7 +128,7 @@ def test_the_export_names_who_made_it_and_with_what_code(tmp_path, capsys, monke
 def test_what_cannot_be_exported_says_why(noisy, tmp_path):
     alone = tmp_path / "alone"
     shutil.copytree(noisy / "dataset", alone)
-    with pytest.raises(ConfigError, match=r"flown with noise 0\.05: its flown actions are only"):
+    with pytest.raises(ConfigError, match=r"flown with noise 0\.1: its flown actions are only"):
         export_dataset(alone, NAME, tmp_path / "m")
     assert not (tmp_path / "m" / "gymfg" / "roll-c172p-v0").exists()
     with pytest.raises(ConfigError, match="no LeRobot dataset at"):
