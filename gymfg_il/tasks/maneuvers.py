@@ -224,9 +224,11 @@ class TurnTask(ManeuverTask):
     | altitude_ft_error_integral | ft·s | that error summed over the steps times dt |
 
     Plan: the turn (magnitude drawn from [60, 180) deg, either way) and the start altitude.
-    Reward: ``0.6 exp(-|remaining| / 30) + 0.4 exp(-|altitude error| / 100)`` minus the usual
-    smoothness term. Success: the altitude stays within 100 ft of the start throughout and
-    the heading is within 5 deg of the new one over the last 10 s. Grade: the altitude error
+    Reward: ``0.3 exp(-|remaining| / 30) + 0.3 exp(-|remaining| / 5) + 0.4 exp(-|altitude
+    error| / 100)`` minus the usual smoothness term: half the heading's share at the success
+    rule's tolerance, so that settling within it pays (at 30 alone 5 deg off kept 85 % of it).
+    Success: the altitude stays within 100 ft of the start throughout and the heading is
+    within 5 deg of the new one over the last 10 s. Grade: the altitude error
     throughout and the heading error over the last 10 s.
     Start and end: as every maneuver (module docstring); 90 s episodes on the c172p, times
     the aircraft's ``maneuver_scale`` (153 s on the f15, 186 on the A320).
@@ -285,7 +287,9 @@ class TurnTask(ManeuverTask):
         return [self.plan["turn_deg"] - self._turned, alt_err, self._integral]
 
     def shaped(self, extras: np.ndarray, state: np.ndarray) -> float:
-        return 0.6 * closeness(extras[0], 30.0) + 0.4 * closeness(extras[1], 100.0)
+        loose, tight = closeness(extras[0], 30.0), closeness(extras[0], self.heading_tolerance)
+        heading = 0.3 * loose + 0.3 * tight  # tight: at the success rule's tolerance
+        return heading + 0.4 * closeness(extras[1], 100.0)
 
     @classmethod
     def judge(

@@ -71,6 +71,22 @@ def test_turn_near_misses_fail():
     assert not TurnTask.judge(plan, turn_states(-240.0), DT).success
 
 
+def test_the_turns_reward_prices_what_its_success_rule_prices():
+    """Ending 5 deg off the new heading fails the turn, so the heading's share of the reward
+    must have fallen well before there: at 30 deg's scale alone a policy 5 deg off kept 85 %
+    of it, and PPO from a novice's clone settled loosely (docs/results/rl.md)."""
+    task = bound(TurnTask, "c172p")
+    state = track(1, heading_deg=30.0)[0]
+
+    def heading_share(remaining):  # the altitude on its target: its 0.4 is earned whole
+        return (task.shaped(np.array([remaining, 0.0, 0.0]), state) - 0.4) / 0.6
+
+    assert heading_share(0.0) == pytest.approx(1.0)
+    assert heading_share(TurnTask.heading_tolerance) < 0.65  # 0.85 before
+    assert heading_share(1.0) > 0.85  # well inside the tolerance: nearly all of it
+    assert heading_share(-5.0) == heading_share(5.0)
+
+
 def test_turn_observes_the_turn_left_unwrapped_across_north():
     task = TurnTask()
     task.bind(c172p("x"), DT, 900)
@@ -212,7 +228,9 @@ def test_plans_scale_with_the_aircraft():
 
 
 # the plans the c172p's maneuvers drew for seed 100 before plans scaled with the aircraft
-# (sha256 of describe()["plan"] as sorted JSON), and its experts' returns on seed 777
+# (sha256 of describe()["plan"] as sorted JSON), and its experts' returns on seed 777 (the
+# turn's since its reward gained its term at the success rule's tolerance, 2026-11-29; it was
+# 734.9468479041827 before, from the same flight)
 C172P_PLANS = {
     "turn": "a9bd35dc6d4f9818de7d2f74673e299b0f1c84ed5505da72a7a3e93e3071c706",
     "climb-turn": "461257328ddcbf7fb3545c1edc8f15e13775f28b33a451301134983893ffe2a5",
@@ -221,7 +239,7 @@ C172P_PLANS = {
     "approach": "5cecd5dcdc200227e12bd3307e6512753086ed0b41f49c8df49f4338a371668d",
 }
 C172P_RETURNS = {
-    "turn": 734.9468479041827,
+    "turn": 703.6371543106565,
     "climb-turn": 615.2731642375754,
     "waypoints": 831.4410726620433,
     "formation": 622.2064911702164,
