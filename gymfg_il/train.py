@@ -145,7 +145,7 @@ def ppo_outcome(result: PPOResult) -> str:
     the actor it saved (the kept one, not necessarily the last evaluated), beside the
     controller on the same seeds; the last evaluation too where it is another actor."""
     first, last, expert = result.curve[0], result.curve[-1], result.controller
-    saved = next((p for p in result.curve if p.step == result.kept.step), last)
+    saved = result.kept  # a point of the curve (``rl.judge.choose``)
     tail = ""
     if saved is not last:
         tail = (
