@@ -162,3 +162,19 @@ def test_a_dataset_whose_episodes_differ_only_in_length_keeps_its_flight():
     frames.episodes["gymfg/spec"][0] = FlightSpec.solo(task="roll", agent_hz=20).to_json()
     flight, why = frames.flight()
     assert flight is None and "2 different flights" in why
+
+
+def test_a_dataset_whose_episodes_differ_only_in_weather_keeps_its_first_episodes_flight():
+    from gymfg_il.envs import FlightSpec
+    from gymfg_il.learning.frames import flight_of
+
+    calm = FlightSpec.solo(task="heading")
+    rough = calm.replace(turbulence="moderate", wind_kt=10.0)
+    specs = [calm.to_json(), rough.to_json(), calm.to_json()]
+    flight, why = flight_of({"gymfg/spec": specs})
+    assert flight == calm
+    assert "2 weathers" in why and "moderate turbulence, 10 kt wind" in why
+    assert flight_of({"gymfg/spec": specs[1:]})[0] == rough  # the first episode's, in order
+    specs.append(calm.replace(task="roll", turbulence="moderate").to_json())
+    flight, why = flight_of({"gymfg/spec": specs})
+    assert flight is None and "3 different flights" in why

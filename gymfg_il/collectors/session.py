@@ -21,7 +21,7 @@ from gymfg_il.datasets import lerobot_api as lr
 from gymfg_il.datasets.features import check_compatible, dataset_features
 from gymfg_il.datasets.provenance import metadata_columns
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE
-from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.flight import STILL_AIR, FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.recording.recorder import LOGS, new_log_path
 from gymfg_il.recording.session import session_record
@@ -110,12 +110,14 @@ def check_appendable(
             f"{'trimmed' if mine.trimmed_starts else 'untrimmed'} and mix two kinds of opening "
             "in one dataset: collect into a new --out folder"
         )
-    if theirs - {mine}:
+    if {t.replace(**STILL_AIR) for t in theirs} - {mine.replace(**STILL_AIR)}:
         log.warning(
             "the dataset at %s holds episodes of another flight (aircraft, task, options or "
             "rate); a policy trained on it will record no single flight to be flown at",
             root,
         )
+    elif theirs - {mine}:  # weather alone: the policy keeps its first episodes' (frames.flight_of)
+        log.info("the dataset at %s holds episodes flown in other weather", root)
 
 
 def already_collected(out: Path, flight: FlightSpec, source: str, noise: float) -> set[int]:

@@ -42,8 +42,13 @@ if TYPE_CHECKING:
     from gymfg_il.envs.single import AircraftEnv
     from gymfg_il.envs.world import SimPool, World
 
-__all__ = ["AircraftSpec", "FlightSpec", "TeamSpec"]
+__all__ = ["STILL_AIR", "AircraftSpec", "FlightSpec", "TeamSpec"]
 SPEC_VERSION = 1
+# the weather fields of a flight in still air: flights equal once these are set differ only in
+# their weather
+STILL_AIR: dict[str, Any] = {
+    "turbulence": "none", "wind_kt": 0.0, "wind_from_deg": None, "gusts": "none"
+}  # fmt: skip
 
 
 def _default_teams() -> tuple[TeamSpec, ...]:

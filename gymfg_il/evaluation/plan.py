@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from gymfg_il.collectors.config import MANUAL_HZ
-from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.flight import STILL_AIR, FlightSpec
 from gymfg_il.envs.options import FlightOptions
 from gymfg_il.errors import ConfigError
 from gymfg_il.evaluation.config import EvalConfig
@@ -82,9 +82,6 @@ def flight_for(
     return base.replace(**changes), weather_notes + notes
 
 
-STILL_AIR = {"turbulence": "none", "wind_kt": 0.0, "wind_from_deg": None}
-
-
 def _weather_notes(known: Mapping[Path, FlightSpec], options: FlightOptions) -> list[str]:
     """Policies whose flights differ only in the weather (a policy fine-tuned in turbulence
     beside the one it started from) fly together in the weather the options give, else the
@@ -95,7 +92,11 @@ def _weather_notes(known: Mapping[Path, FlightSpec], options: FlightOptions) -> 
     first = next(iter(weathers))
     flown = {**weathers[first], **{k: v for k, v in options.given().items() if k in STILL_AIR}}
     whose = "as asked" if any(k in options.given() for k in STILL_AIR) else f"{first}'s"
-    said = ", ".join(f"{k}={flown[k]!r}" for k in STILL_AIR if k != "wind_from_deg")
+    said = ", ".join(
+        f"{k}={flown[k]!r}"
+        for k in STILL_AIR
+        if k != "wind_from_deg" and (k != "gusts" or flown[k] != "none")
+    )
     trained = "; ".join(
         f"{p}: {'no' if w['turbulence'] == 'none' else w['turbulence']} turbulence, "
         f"{w['wind_kt']:g} kt wind"

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.flight import STILL_AIR, FlightSpec
 from gymfg_il.errors import ConfigError
 
 
@@ -111,8 +111,10 @@ def episode_runs(episode: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
     """The solo flight every episode (``gymfg/*`` columns) was flown as (a team run's
-    aircraft on its own; the longest episode time where only that differs), and why there is
-    none when the episodes disagree on more or predate flight specs."""
+    aircraft on its own; the longest episode time where only that differs; the first
+    episode's weather where only the weather differs, as when DAgger rounds flown in
+    turbulence join still-air demonstrations, said in the note), and why there is none when
+    the episodes disagree on more or predate flight specs."""
     specs = episodes.get("gymfg/spec")
     if not specs:
         return None, (
@@ -120,18 +122,30 @@ def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
             "editing dropped them: `python -m gymfg_il.collect repair DIR --source ORIGINAL`)"
         )
     callsigns = episodes.get("gymfg/callsign") or ["ego"] * len(specs)
-    found = {
+    found = [  # in episode order
         FlightSpec.from_json(text).for_callsign(c)
-        for text, c in set(zip(specs, callsigns, strict=True))
-    }
+        for text, c in dict.fromkeys(zip(specs, callsigns, strict=True))
+    ]
     longest = max(s.episode_time_s for s in found)
-    alike = {s.replace(episode_time_s=longest) for s in found}
-    if len(alike) > 1:
+    alike = list(dict.fromkeys(s.replace(episode_time_s=longest) for s in found))
+    if len({s.replace(**STILL_AIR) for s in alike}) > 1:
         return None, (
             f"its episodes were flown in {len(alike)} different flights (aircraft, task, "
             "options or rate)"
         )
-    return alike.pop(), ""
+    own = alike[0]
+    if len(alike) == 1:
+        return own, ""
+    weathers = "; ".join(_weather_text(s) for s in alike)
+    return own, (
+        f"its episodes were flown in {len(alike)} weathers ({weathers}); its own flight is "
+        "its first episode's"
+    )
+
+
+def _weather_text(spec: FlightSpec) -> str:
+    parts = [f"{spec.turbulence} turbulence", f"{spec.wind_kt:g} kt wind"]
+    return ", ".join(parts + ([f"{spec.gusts} gusts"] if spec.gusts != "none" else []))
 
 
 def observed_names(spec: str, callsign: str) -> tuple[str, ...] | None:
