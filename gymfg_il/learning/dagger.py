@@ -7,9 +7,8 @@ from a copy of the policy's dataset and links those episodes' logs into its ``lo
 from __future__ import annotations
 
 import logging
-import math
 import shutil
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, Literal
@@ -22,7 +21,6 @@ from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.learning.config import TrainConfig
 from gymfg_il.rollout.agents import AgentSpec
-from gymfg_il.sim.weather import TURBULENCE, Turbulence
 from gymfg_il.workers import Workers
 
 log = logging.getLogger(__name__)
@@ -34,7 +32,7 @@ class DaggerConfig:
 
     Attributes:
         policy: checkpoint to start from; it flies its own flight spec (aircraft, task and
-            options, rate, episode time, weather) unless a weather is given below.
+            options, rate, episode time).
         out: session folder: logs/, dataset/ (the aggregate), policy-<k>/.
         expert: who labels the visited states: the task's controller.
         iterations: rounds of fly / label / aggregate / retrain.
@@ -44,11 +42,6 @@ class DaggerConfig:
         workers: worker processes flying episodes.
         ray: fly the episodes on a Ray cluster instead: auto, local or HOST:PORT (results
             identical to one worker).
-        turbulence: fly the rounds in this turbulence (none, light, moderate, severe)
-            instead of the policy's own weather, so the expert labels the states that air
-            takes the policy to (a still-air clone's rounds in moderate turbulence); the
-            retrained policy keeps its first episodes' weather as its own.
-        wind_kt: fly the rounds in this steady wind (from a direction drawn per episode).
     """
 
     policy: Path
@@ -60,8 +53,6 @@ class DaggerConfig:
     epochs: int | None = None
     workers: int = 1
     ray: str | None = None
-    turbulence: Turbulence | None = None
-    wind_kt: float | None = None
 
     def __post_init__(self) -> None:
         self.policy, self.out = Path(self.policy), Path(self.out)
@@ -74,17 +65,6 @@ class DaggerConfig:
             bad.append(f"epochs={self.epochs!r}")
         if bad:
             raise ConfigError(f"dagger: {', '.join(bad)} must be integers >= 1")
-        if self.turbulence is not None and self.turbulence not in TURBULENCE:
-            raise ConfigError(
-                f"dagger: turbulence={self.turbulence!r}: one of {', '.join(TURBULENCE)}"
-            )
-        if self.wind_kt is not None and not (math.isfinite(self.wind_kt) and self.wind_kt >= 0):
-            raise ConfigError(f"dagger: wind_kt={self.wind_kt!r} must be a number >= 0")
-
-    def weather(self) -> dict[str, Any]:
-        """The weather options given (None: the policy's own)."""
-        given = {"turbulence": self.turbulence, "wind_kt": self.wind_kt}
-        return {k: v for k, v in given.items() if v is not None}
 
     def run(
         self, on_iteration: Callable[[DaggerIteration], None] | None = None
@@ -93,7 +73,7 @@ class DaggerConfig:
         overrides = {"epochs": self.epochs} if self.epochs else {}
         return run_dagger(
             self.policy, self.out, self.iterations, self.episodes, self.seed, self.workers,
-            overrides, on_iteration, self.ray, self.weather(),
+            overrides, on_iteration, self.ray,
         )  # fmt: skip
 
 
@@ -117,11 +97,8 @@ def run_dagger(
     train_overrides: dict[str, Any] | None = None,
     on_iteration: Callable[[DaggerIteration], None] | None = None,
     ray: str | None = None,
-    weather: Mapping[str, Any] | None = None,
 ) -> list[DaggerIteration]:
-    """``iterations`` rounds of fly / label / aggregate / retrain, starting from ``policy``,
-    flown in its own flight with the ``weather`` options given (``turbulence``, ``wind_kt``)
-    replacing its own."""
+    """``iterations`` rounds of fly / label / aggregate / retrain, starting from ``policy``."""
     from gymfg_il.datasets.from_logs import build_from_logs
     from gymfg_il.learning.bc import train_bc
 
@@ -129,8 +106,6 @@ def run_dagger(
         raise ConfigError("iterations and episodes must be >= 1")
     meta = AgentSpec.policy(policy).meta()
     flight = _own_flight(policy, meta)
-    if weather:
-        flight = flight.replace(**weather)
     root = out / DATASET
     if not root.exists():
         _start_session(Path(meta.get("dataset", "")), out)

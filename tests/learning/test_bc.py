@@ -144,3 +144,33 @@ def test_default_epochs_follow_who_demonstrated(tiny_dataset):
         sources[2] = person
         frames.episodes = {**frames.episodes, "gymfg/source": sources}
         assert default_epochs(frames) == EPOCHS_PERSON == 20
+
+
+def test_demonstrations_flown_in_two_weathers_train_a_policy_of_the_first_ones_flight(
+    tmp_path, caplog
+):
+    # a person adds gusty flights (or the autopilot turbulent ones) to the calm ones already
+    # there: one dataset, and the policy still records the flight it flies by default
+    from gymfg_il.collectors.autopilot import collect_autopilot
+    from gymfg_il.collectors.config import CollectConfig
+
+    calm = CollectConfig(task="heading", episodes=2, episode_time_s=3, out=tmp_path / "s")
+    collect_autopilot(calm)
+    caplog.set_level("INFO", logger="gymfg_il.collectors.session")
+    rough = CollectConfig(
+        task="heading", episodes=1, episode_time_s=3, seed=1100, turbulence="moderate",
+        out=tmp_path / "s",
+    )  # fmt: skip
+    collect_autopilot(rough)
+    assert "another flight" not in caplog.text and "in other weather" in caplog.text
+    result = train_bc(TrainConfig(dataset=tmp_path / "s" / "dataset", out=tmp_path / "p", epochs=1))
+    meta = json.loads((result.out / "config.json").read_text())
+    assert meta["spec"]["turbulence"] == "none" and meta["task"] == "heading"
+    assert "2 weathers" in meta["spec_note"]
+    caplog.clear()
+    jet = CollectConfig(
+        task="heading", aircraft="f15", episodes=1, episode_time_s=3, seed=1200,
+        out=tmp_path / "s",
+    )  # fmt: skip
+    collect_autopilot(jet)  # another aircraft is another flight, as before
+    assert "another flight" in caplog.text

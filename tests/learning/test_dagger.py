@@ -88,43 +88,6 @@ def test_dagger_flies_the_policys_own_flight(tmp_path):
     assert FlightSpec.from_dict(retrained["spec"]) == demo.flight()
 
 
-def test_dagger_rounds_fly_in_the_turbulence_asked_and_the_policy_keeps_its_own_air(tmp_path):
-    from gymfg_il.collectors.autopilot import collect_autopilot
-    from gymfg_il.learning.dagger import DaggerConfig
-    from gymfg_il.recording.reader import read_log
-
-    demo = CollectConfig(
-        task="heading", episodes=2, episode_time_s=4, seed=1000, out=tmp_path / "demo"
-    )
-    collect_autopilot(demo)
-    bc = train_bc(TrainConfig(dataset=tmp_path / "demo" / "dataset", out=tmp_path / "bc", epochs=1))
-    cfg = DaggerConfig(
-        bc.out, tmp_path / "dagger", iterations=1, episodes=2, epochs=1, turbulence="moderate"
-    )
-    (step,) = cfg.run()
-    (log_path,) = (tmp_path / "dagger" / "logs").glob("dagger-*.mcap")
-    assert read_log(log_path).spec == demo.flight().replace(turbulence="moderate")
-    retrained = AgentSpec.policy(step.policy).meta()
-    assert FlightSpec.from_dict(retrained["spec"]) == demo.flight()  # its first episodes' air
-    assert "2 weathers" in retrained["spec_note"]
-    frames = load_frames(tmp_path / "dagger" / "dataset")
-    assert [FlightSpec.from_json(s).turbulence for s in frames.episodes["gymfg/spec"]] == [
-        "none", "none", "moderate", "moderate"
-    ]  # fmt: skip
-
-
-@pytest.mark.parametrize(
-    ("field", "value", "said"),
-    [("turbulence", "stormy", "turbulence='stormy'"), ("wind_kt", -5.0, "wind_kt=-5.0")],
-)
-def test_dagger_refuses_weather_it_cannot_fly(tmp_path, field, value, said):
-    from gymfg_il.errors import ConfigError
-    from gymfg_il.learning.dagger import DaggerConfig
-
-    with pytest.raises(ConfigError, match=said):
-        DaggerConfig(tmp_path / "p", tmp_path / "o", **{field: value})
-
-
 @pytest.mark.slow
 def test_recover_rebuilds_every_episode_of_a_dagger_session_and_names_what_it_cannot(
     tmp_path, capsys
