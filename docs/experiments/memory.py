@@ -115,13 +115,16 @@ def case_rows(out: Path, case: str, task: str, noise: float, args: argparse.Name
 
 
 def main() -> None:
+    from gymfg_il.collectors.config import CollectConfig
+
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("out", type=Path, help="folder for the datasets and policies")
     parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
     parser.add_argument("--tasks", nargs="+", default=["altitude", "heading"])
     parser.add_argument(
-        "--noise", nargs="+", type=float, default=[0.1], help="DART noise (collect's default)"
-    )
+        "--noise", nargs="+", type=float, default=None,
+        help="DART noise (default: collect's, each task's own)",
+    )  # fmt: skip
     parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
     parser.add_argument("--episodes", type=int, default=16)
     parser.add_argument("--seed", type=int, default=7000, help="first held-out seed")
@@ -132,7 +135,8 @@ def main() -> None:
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for case in args.cases:
         for task in args.tasks:
-            for noise in args.noise:
+            own = CollectConfig(task=task).dart_noise()
+            for noise in args.noise or [own]:
                 case_rows(args.out, case, task, noise, args)
 
 

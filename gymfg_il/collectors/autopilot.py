@@ -25,7 +25,7 @@ def seeds_to_fly(cfg: CollectConfig) -> list[int]:
     """``cfg``'s seeds less those whose episode the session's dataset already holds (the
     same flight, source and noise): running a recipe twice re-makes its dataset instead of
     doubling it."""
-    have = already_collected(cfg.out, cfg.flight(), "autopilot", cfg.noise)
+    have = already_collected(cfg.out, cfg.flight(), "autopilot", cfg.dart_noise())
     seeds = [s for s in range(cfg.seed, cfg.seed + cfg.episodes) if s not in have]
     if len(seeds) < cfg.episodes:
         log.info(
@@ -52,7 +52,7 @@ def record_autopilot(
         range(cfg.seed, cfg.seed + cfg.episodes) if seeds is None else seeds,
         cfg.out,
         "autopilot",
-        noise=cfg.noise,
+        noise=cfg.dart_noise(),
         workers=workers,
         progress=progress,
         images=cfg.images,

@@ -20,10 +20,11 @@ from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 from gymfg_il.datasets.videos import DEFAULT_IMAGE_SIZE, check_views
-from gymfg_il.envs.options import FlightOptions
+from gymfg_il.envs.options import FlightOptions, unset_values
 from gymfg_il.errors import ConfigError, join_problems
 from gymfg_il.names import name_problem
-from gymfg_il.tasks.library import TASK_FAMILIES, TRACKED_TASKS
+from gymfg_il.tasks.base import Task
+from gymfg_il.tasks.library import TASK_FAMILIES, TRACKED_TASKS, task_class
 from gymfg_il.typecheck import seed_problem, type_problems
 
 
@@ -39,6 +40,8 @@ class CollectConfig(FlightOptions):
             control, throttle included (the dataset keeps the demonstrator's clean action as
             the label), so the demonstrations show how to recover from small deviations,
             which behaviour cloning from a controller's demonstrations needs; 0 = none.
+            Default: the task's own (``Task.demonstration_noise``): 0.1, the fixed heading's
+            0.2.
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
         images: camera views to add to the dataset as LeRobot video features
             ``observation.images.<view>``: ``front`` (the pilot's eye) and/or ``chase``
@@ -49,7 +52,7 @@ class CollectConfig(FlightOptions):
 
     episodes: int = 10
     seed: int = 1000
-    noise: float = 0.1
+    noise: float | None = None
     out: Path = Path("datasets/autopilot")
     images: list[str] = field(default_factory=list)
     image_size: int = DEFAULT_IMAGE_SIZE
@@ -69,6 +72,18 @@ class CollectConfig(FlightOptions):
         """The fewest episodes a session may be asked for."""
         return 1
 
+    def dart_noise(self) -> float:
+        """The DART noise the autopilot's episodes fly with: ``noise``, or unset, the task's
+        own (``Task.demonstration_noise``; for a task that cannot be built the common one,
+        and ``problems`` names the task)."""
+        if self.noise is not None:
+            return self.noise
+        try:
+            task = task_class(self.task or unset_values()["task"], bool(self.dynamic))
+        except ConfigError:
+            task = Task
+        return task.demonstration_noise
+
     def problems(self) -> list[str]:
         """What is wrong with these values, each with its fix (empty: nothing)."""
         problems = []
@@ -86,7 +101,7 @@ class CollectConfig(FlightOptions):
             problems.append(f"episodes={self.episodes!r} must be an integer >= {least}")
         elif problem := seed_problem(self.seed, self.episodes):  # the last episode's seed
             problems.append(problem)
-        if not (math.isfinite(self.noise) and self.noise >= 0):
+        if self.noise is not None and not (math.isfinite(self.noise) and self.noise >= 0):
             problems.append(f"noise={self.noise!r} must be a number >= 0")
         if self.gusts not in (None, "none") and not self.logs_gusts:
             problems.append(

@@ -14,7 +14,7 @@ step, so the export re-flies every episode in the env it names, from its seed, a
 final observation, rewards and flags from that flight. The flown actions come from the
 session's logs (``DIR/logs`` beside ``DIR/dataset``), and the re-flown observations must then
 equal the dataset's bit for bit. Without the logs the dataset's ``action`` column is flown:
-that is what was flown only without collection noise (DART's ``--noise``, 0.1 by default,
+that is what was flown only without collection noise (DART's ``--noise``, the task's own,
 is in the log alone, so such a dataset needs its logs), and being float32 it re-flies within
 rounding (measured: at most 5e-6 relative over 90 s; ``refly.NEAR`` allows 1e-3), so the dataset's
 own observations are kept and only the last comes from the flight. Actions are stored as

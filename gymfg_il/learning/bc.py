@@ -58,9 +58,9 @@ class TrainResult:
             f"validation loss {val:.4f} is {val / train:.1f}x the training loss {train:.4f}: "
             "the policy fits its demonstrations far better than episodes it has not seen, so "
             "it may not recover from its own deviations. More demonstrations help; so do "
-            "DART noise for autopilot ones (collect autopilot --noise, 0.1 by default), "
-            "`collect dagger`, and a person taking over from the policy (collect manual "
-            "--assist)"
+            "DART noise for autopilot ones (collect autopilot --noise, the task's own by "
+            "default: 0.1, the heading's 0.2), `collect dagger`, and a person taking over "
+            "from the policy (collect manual --assist)"
         )
 
 

@@ -91,6 +91,9 @@ class Task:
     # what a policy cloned from this task's own expert remembers (``memory``); None: what a
     # clone of anyone's demonstrations does
     expert_memory: ClassVar[str | None] = None
+    # the DART noise of its autopilot's demonstrations unless a collection sets one (the std
+    # added to each executed control; ``collect autopilot --noise``)
+    demonstration_noise: ClassVar[float] = 0.1
 
     @classmethod
     def episode_time_for(cls, profile: FlightProfile) -> float:

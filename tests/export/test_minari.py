@@ -30,7 +30,7 @@ def _session(out, noise):
 @pytest.fixture(scope="module")
 def noisy(tmp_path_factory):
     """Two 3 s roll episodes with the default DART noise: flown actions differ from labels."""
-    return _session(tmp_path_factory.mktemp("minari") / "run", CollectConfig.noise)
+    return _session(tmp_path_factory.mktemp("minari") / "run", None)  # the task's own
 
 
 def test_minari_opens_the_export_and_recovers_the_env_it_was_flown_in(noisy, tmp_path, monkeypatch):

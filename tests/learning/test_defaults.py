@@ -24,7 +24,7 @@ def test_clean_demonstrations_with_default_settings_give_a_policy_that_does_not_
     task, demonstrations, tmp_path
 ):
     cfg = CollectConfig(task=task, episodes=demonstrations, seed=1000, out=tmp_path / "demos")
-    assert cfg.noise > 0  # the default that makes the rest hold
+    assert cfg.dart_noise() > 0  # the default that makes the rest hold
     collect_autopilot(cfg, workers=2)
     result = train_bc(TrainConfig(dataset=tmp_path / "demos" / "dataset", out=tmp_path / "p"))
     assert not result.overfit
@@ -52,3 +52,16 @@ def test_train_says_when_validation_loss_is_far_above_training_loss(tmp_path):
     # with the throttle noised, read 60x and flew every held-out episode)
     noised = TrainResult(tmp_path, [0.5, 0.0544], [0.5, 3.2428], 1.0, 100, {}, noised=True)
     assert noised.overfit == "" and "59.6x" in result(0.0544, 3.2428).overfit
+
+
+def test_each_task_demonstrates_with_its_own_noise_unless_told(tmp_path):
+    from gymfg_il.recording.reader import read_log
+
+    assert CollectConfig(task="altitude").dart_noise() == 0.1
+    assert CollectConfig(task="heading").dart_noise() == 0.2  # its slope needs it
+    assert CollectConfig(task="heading", dynamic=True).dart_noise() == 0.1
+    assert CollectConfig(task="heading", noise=0.0).dart_noise() == 0.0  # asked: kept
+    cfg = CollectConfig(task="heading", episodes=1, episode_time_s=2, out=tmp_path / "s")
+    collect_autopilot(cfg)
+    (log,) = (tmp_path / "s" / "logs").glob("*.mcap")
+    assert read_log(log).session["noise"] == 0.2
