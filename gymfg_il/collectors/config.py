@@ -40,8 +40,8 @@ class CollectConfig(FlightOptions):
             control, throttle included (the dataset keeps the demonstrator's clean action as
             the label), so the demonstrations show how to recover from small deviations,
             which behaviour cloning from a controller's demonstrations needs; 0 = none.
-            Default: the task's own (``Task.demonstration_noise``): 0.1, the fixed heading's
-            0.2.
+            Default: the task's own (``Task.demonstration_noise``): 0.1; the fixed heading's
+            and the turn's 0.2.
         out: session folder: ``logs/`` (MCAP) and ``dataset/`` (LeRobot) inside.
         images: camera views to add to the dataset as LeRobot video features
             ``observation.images.<view>``: ``front`` (the pilot's eye) and/or ``chase``

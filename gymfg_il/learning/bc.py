@@ -59,8 +59,8 @@ class TrainResult:
             "the policy fits its demonstrations far better than episodes it has not seen, so "
             "it may not recover from its own deviations. More demonstrations help; so do "
             "DART noise for autopilot ones (collect autopilot --noise, the task's own by "
-            "default: 0.1, the heading's 0.2), `collect dagger`, and a person taking over "
-            "from the policy (collect manual --assist)"
+            "default: 0.1, the heading's and the turn's 0.2), `collect dagger`, and a person "
+            "taking over from the policy (collect manual --assist)"
         )
 
 

@@ -60,6 +60,8 @@ def test_each_task_demonstrates_with_its_own_noise_unless_told(tmp_path):
     assert CollectConfig(task="altitude").dart_noise() == 0.1
     assert CollectConfig(task="heading").dart_noise() == 0.2  # its slope needs it
     assert CollectConfig(task="heading", dynamic=True).dart_noise() == 0.1
+    assert CollectConfig(task="turn").dart_noise() == 0.2
+    assert CollectConfig(task="climb-turn").dart_noise() == 0.1
     assert CollectConfig(task="heading", noise=0.0).dart_noise() == 0.0  # asked: kept
     cfg = CollectConfig(task="heading", episodes=1, episode_time_s=2, out=tmp_path / "s")
     collect_autopilot(cfg)
