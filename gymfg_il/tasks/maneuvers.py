@@ -238,10 +238,7 @@ class TurnTask(ManeuverTask):
     # from its expert's demonstrations, every loop: from five, 100 % on two sets against
     # 75-100 % without memory (docs/results/memory.md)
     expert_memory = "loops"
-    # its hold is the heading's (``ReachStaticTargetHeadingTask``): from five, 100 % on five
-    # sets at 0.2 (0.1: 94 % on one); still-air clones in gusts 81 % and no crash (0.1: 31 %,
-    # 11 crashes); from 50 on three aircraft as at 0.1 (docs/results/defaults.md)
-    demonstration_noise = 0.2
+    demonstration_noise = 0.2  # its hold is the heading's slope (docs/results/defaults.md)
 
     extra_names = ("turn_remaining_deg", "altitude_ft_error", "altitude_ft_error_integral")
     tracked_entry = ("heading_deg", "turn_remaining_deg", 5.0)
