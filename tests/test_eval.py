@@ -173,8 +173,10 @@ def test_a_dataset_whose_episodes_differ_only_in_weather_keeps_its_first_episode
     specs = [calm.to_json(), rough.to_json(), calm.to_json()]
     flight, why = flight_of({"gymfg/spec": specs})
     assert flight == calm
-    assert "2 weathers" in why and "moderate turbulence, 10 kt wind" in why
+    assert "2 weathers (no turbulence, 0 kt wind; moderate turbulence, 10 kt wind)" in why
     assert flight_of({"gymfg/spec": specs[1:]})[0] == rough  # the first episode's, in order
     specs.append(calm.replace(task="roll", turbulence="moderate").to_json())
     flight, why = flight_of({"gymfg/spec": specs})
-    assert flight is None and "3 different flights" in why
+    assert flight is None and "2 different flights" in why  # heading and roll
+    gusty = calm.replace(gusts="moderate").to_json()
+    assert "moderate gusts" in flight_of({"gymfg/spec": [calm.to_json(), gusty]})[1]

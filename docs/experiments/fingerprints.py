@@ -104,6 +104,8 @@ def fingerprints(work: Path) -> dict[str, str]:
         "20",
         "--seed",
         "7000",
+        "--noise",
+        "0.1",  # the turn's own is 0.2 since 2026-11-29: fingerprints stay comparable
         "--out",
         str(auto),
         "--no-progress",

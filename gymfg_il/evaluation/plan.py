@@ -99,7 +99,7 @@ def _weather_notes(known: Mapping[Path, FlightSpec], options: FlightOptions) -> 
     )
     trained = "; ".join(
         f"{p}: {'no' if w['turbulence'] == 'none' else w['turbulence']} turbulence, "
-        f"{w['wind_kt']:g} kt wind"
+        f"{w['wind_kt']:g} kt wind" + (f", {w['gusts']} gusts" if w["gusts"] != "none" else "")
         for p, w in weathers.items()
     )
     return [

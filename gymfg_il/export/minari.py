@@ -227,8 +227,11 @@ def _solo_flight(frames: Frames, folder: Path) -> FlightSpec:
     """The one solo flight every episode of the dataset at ``folder`` was flown as, or an
     error saying why there is none."""
     flight, why = frames.flight()
-    if flight is None:
-        raise ConfigError(f"the dataset at {folder} names no one flight: {why}")
+    if flight is None or why:  # a note: the episodes' weather differs (``flight_of``)
+        raise ConfigError(
+            f"the dataset at {folder} names no one flight: {why}"
+            + ("; a Minari dataset names one env: export the episodes of one air" if flight else "")
+        )
     team_runs = {
         c for c, s in zip(frames.episodes["gymfg/callsign"], frames.episodes["gymfg/spec"],
                           strict=True) if not FlightSpec.from_json(s).is_solo

@@ -128,9 +128,10 @@ def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
     ]
     longest = max(s.episode_time_s for s in found)
     alike = list(dict.fromkeys(s.replace(episode_time_s=longest) for s in found))
-    if len({s.replace(**STILL_AIR) for s in alike}) > 1:
+    calm = {s.replace(**STILL_AIR) for s in alike}
+    if len(calm) > 1:
         return None, (
-            f"its episodes were flown in {len(alike)} different flights (aircraft, task, "
+            f"its episodes were flown in {len(calm)} different flights (aircraft, task, "
             "options or rate)"
         )
     own = alike[0]
@@ -144,7 +145,8 @@ def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
 
 
 def _weather_text(spec: FlightSpec) -> str:
-    parts = [f"{spec.turbulence} turbulence", f"{spec.wind_kt:g} kt wind"]
+    turbulence = "no" if spec.turbulence == "none" else spec.turbulence
+    parts = [f"{turbulence} turbulence", f"{spec.wind_kt:g} kt wind"]
     return ", ".join(parts + ([f"{spec.gusts} gusts"] if spec.gusts != "none" else []))
 
 

@@ -163,3 +163,16 @@ def test_a_team_run_is_refused_by_name(tmp_path):
     assert recover(tmp_path) == 0
     with pytest.raises(ConfigError, match="holds team-run episodes \\(lead, wing flew beside"):
         export_dataset(tmp_path, NAME, tmp_path / "m")
+
+
+def test_episodes_flown_in_two_airs_are_refused_not_reflown_in_one(tmp_path):
+    # a policy keeps the first episodes' flight (learning.frames.flight_of); an export that
+    # re-flies every episode in one env cannot
+    out = _session(tmp_path / "run", None)
+    rough = CollectConfig(
+        aircraft="c172p", task="roll", episodes=1, episode_time_s=3.0, seed=40,
+        turbulence="moderate", out=out,
+    )  # fmt: skip
+    collect_autopilot(rough)
+    with pytest.raises(ConfigError, match="2 weathers.*export the episodes of one air"):
+        export_dataset(out, NAME, tmp_path / "minari")
