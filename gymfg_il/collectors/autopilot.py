@@ -11,7 +11,7 @@ from gymfg_il.collectors.session import (
     DATASET,
     LOGS,
     SessionResult,
-    already_collected,
+    collected,
     record_session,
 )
 from gymfg_il.datasets.from_logs import BuildReport, build_from_logs
@@ -25,8 +25,21 @@ def seeds_to_fly(cfg: CollectConfig) -> list[int]:
     """``cfg``'s seeds less those whose episode the session's dataset already holds (the
     same flight, source and noise): running a recipe twice re-makes its dataset instead of
     doubling it."""
-    have = already_collected(cfg.out, cfg.flight(), "autopilot", cfg.dart_noise())
+    noise = cfg.dart_noise()
+    held = collected(cfg.out, cfg.flight(), "autopilot")
+    have = {seed for seed, n in held if n == noise}
     seeds = [s for s in range(cfg.seed, cfg.seed + cfg.episodes) if s not in have]
+    other = sorted({n for seed, n in held if seed in seeds and n != noise})
+    if other:  # e.g. a dataset made before its task's own noise changed
+        log.warning(
+            "the dataset at %s holds episodes of these seeds flown with noise %s; these fly "
+            "with %g (%s) and join them: pass --noise %g to re-make those instead",
+            cfg.out / DATASET,
+            ", ".join(f"{n:g}" for n in other),
+            noise,
+            "as asked" if cfg.noise is not None else "the task's own",
+            other[0],
+        )
     if len(seeds) < cfg.episodes:
         log.info(
             "the dataset at %s already holds %d of these episodes; flying the other %d",

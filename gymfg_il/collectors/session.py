@@ -120,9 +120,8 @@ def check_appendable(
         log.info("the dataset at %s holds episodes flown in other weather", root)
 
 
-def already_collected(out: Path, flight: FlightSpec, source: str, noise: float) -> set[int]:
-    """Seeds whose episode of this flight, source and noise the dataset at ``out`` holds
-    (collecting them again would only add copies)."""
+def collected(out: Path, flight: FlightSpec, source: str) -> set[tuple[int, float]]:
+    """(seed, noise) of each episode of this flight and source the dataset at ``out`` holds."""
     root = out / DATASET
     if not (root / "meta" / "info.json").is_file():
         return set()
@@ -132,9 +131,9 @@ def already_collected(out: Path, flight: FlightSpec, source: str, noise: float) 
         return set()
     rows = zip(*(episodes[c] for c in need), strict=True)
     return {
-        int(seed)
+        (int(seed), float(n))
         for seed, spec, src, n in rows
-        if src == source and float(n) == float(noise) and FlightSpec.from_json(spec) == flight
+        if src == source and FlightSpec.from_json(spec) == flight
     }
 
 

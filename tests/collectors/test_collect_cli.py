@@ -197,6 +197,19 @@ def test_running_a_recipe_again_remakes_its_dataset_instead_of_doubling_it(tmp_p
     assert LeRobotDataset("x/y", root=tmp_path / "s" / "dataset").num_episodes == 3
 
 
+def test_a_dataset_made_at_another_noise_is_named_before_its_seeds_fly_again(tmp_path, caplog):
+    # the heading's own noise was 0.1 before 2026-11-29: the same command now flies at 0.2
+    base = ["autopilot", "--task", "heading", "--episodes", "1", "--episode-time", "2"]
+    base += ["--out", str(tmp_path / "s"), "--no-progress"]
+    assert collect.main([*base, "--noise", "0.1"]) == 0
+    caplog.clear()
+    assert collect.main([*base, "--noise", "0.1"]) == 0  # the same: nothing flies, no warning
+    assert "flown with noise" not in caplog.text
+    assert collect.main(base) == 0
+    assert "flown with noise 0.1; these fly with 0.2 (the task's own)" in caplog.text
+    assert "pass --noise 0.1 to re-make those instead" in caplog.text
+
+
 def test_an_untrimmed_dataset_takes_no_trimmed_episodes(tmp_path):
     from gymfg_il.collectors.session import check_appendable
     from gymfg_il.envs import FlightSpec
