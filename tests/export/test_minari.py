@@ -174,5 +174,5 @@ def test_episodes_flown_in_two_airs_are_refused_not_reflown_in_one(tmp_path):
         turbulence="moderate", out=out,
     )  # fmt: skip
     collect_autopilot(rough)
-    with pytest.raises(ConfigError, match="2 weathers.*export the episodes of one air"):
+    with pytest.raises(ConfigError, match=r"2 weathers.*export the episodes of one air"):
         export_dataset(out, NAME, tmp_path / "minari")
