@@ -25,7 +25,7 @@ from typing import Any
 
 from gymfg_il.aircraft import Aircraft
 from gymfg_il.envs.config import EnvConfig
-from gymfg_il.envs.flight import FlightSpec
+from gymfg_il.envs.flight import STILL_AIR, FlightSpec
 from gymfg_il.envs.roster import AircraftSpec, TeamSpec
 from gymfg_il.errors import ConfigError
 from gymfg_il.sim.gusts import GustLevel
@@ -40,7 +40,7 @@ AIRCRAFT_OPTIONS = {
     "dynamic": "dynamic",
     "task_kwargs": "task_kwargs",
 }
-WEATHER_OPTIONS = ("turbulence", "wind_kt", "wind_from_deg", "gusts")
+WEATHER_OPTIONS = tuple(STILL_AIR)  # turbulence, wind_kt, wind_from_deg, gusts
 TASK_OWN_TIME = (
     "the task's own: 90 s for most, 120 for waypoints, 180 for approach (on the c172p; "
     "the turns, waypoints and formation last longer on aircraft that turn slower)"

@@ -112,8 +112,8 @@ def episode_runs(episode: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def flight_of(episodes: dict[str, list[Any]]) -> tuple[FlightSpec | None, str]:
     """The solo flight every episode (``gymfg/*`` columns) was flown as (a team run's
     aircraft on its own; the longest episode time where only that differs; the first
-    episode's weather where only the weather differs, as when DAgger rounds flown in
-    turbulence join still-air demonstrations, said in the note), and why there is none when
+    episode's weather where only the weather differs, as when `collect manual --gusts`
+    episodes join calm ones, said in the note), and why there is none when
     the episodes disagree on more or predate flight specs."""
     specs = episodes.get("gymfg/spec")
     if not specs:
