@@ -4,12 +4,14 @@ whoever flies it carries its state (``tiny_gru``, ``carried_state``)."""
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import os
 import select
 import shutil
 import socket
 import subprocess
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +22,12 @@ XVFB_DEADLINE_S = 180  # a loaded 2-core machine is slow; only a failure waits t
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+# Hugging Face datasets caches every parquet file LeRobot opens as Arrow under
+# ~/.cache/huggingface/datasets and never removes it: a test run opens thousands (GBs over a
+# few runs). The tests' own cache goes with the run (set before anything imports datasets).
+_HF_CACHE = tempfile.mkdtemp(prefix="gymfg-hf-datasets-")
+os.environ["HF_DATASETS_CACHE"] = _HF_CACHE
+atexit.register(shutil.rmtree, _HF_CACHE, ignore_errors=True)
 
 
 @pytest.fixture
