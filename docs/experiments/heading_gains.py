@@ -4,8 +4,11 @@ the clone flies its own flight (``--turbulence`` to change the air) on a few see
 measured by finite differences, one degree more heading error (target and error moved
 together) and one degree more roll, and divided by the autopilot's unsaturated slopes there
 (``heading_to_roll`` x the roll loop's gain, and the roll loop's gain). Prints the median
-and the 10th and 90th percentiles of each ratio. Not a feature: the diagnosis behind
-docs/results/memory.md ("Still-air demonstrations, flown in moderate turbulence").
+and the 10th and 90th percentiles of each ratio, and of the rudder's answer to that degree
+of heading error (the autopilot's rudder sees only the sideslip: 0; a rudder that holds the
+heading in gusts, docs/experiments/hold_gains.py, -0.02 to -0.05). Not a feature: the
+diagnosis behind docs/results/memory.md ("Still-air demonstrations, flown in moderate
+turbulence") and docs/results/rl.md.
 
     python docs/experiments/heading_gains.py POLICY [--turbulence moderate] [--seeds 7000 7004]
 """
@@ -48,12 +51,13 @@ def main() -> None:
     heading_slope = expert.gains.heading_to_roll * expert.roll_pid.kp
     roll_slope = -expert.roll_pid.kp
 
-    def aileron(x: np.ndarray) -> float:
+    def controls(x: np.ndarray) -> np.ndarray:
         with torch.no_grad():
             out = policy.action_norm.inverse(policy.forward(torch.as_tensor(x[None])))
-        return float(out[0, 0])
+        return out[0].numpy()
 
     ratios: dict[str, list[float]] = {"heading": [], "roll": []}
+    rudder: list[float] = []
     start = int(args.after / env.dt)
     for seed in range(*args.seeds):
         obs, _ = env.reset(seed=seed)
@@ -64,12 +68,14 @@ def main() -> None:
                 memory = agent._state[0] if agent._state is not None else None
                 held = [] if memory is None else [pid.integral for pid in memory.pids]
                 x = np.concatenate([obs, held]).astype(np.float32)
-                base = aileron(x)
+                base = controls(x)
                 turned, rolled = x.copy(), x.copy()
                 turned[[error, target]] += 1.0
                 rolled[roll] += 1.0
-                ratios["heading"].append((aileron(turned) - base) / heading_slope)
-                ratios["roll"].append((aileron(rolled) - base) / roll_slope)
+                answer = controls(turned) - base
+                ratios["heading"].append(answer[0] / heading_slope)
+                ratios["roll"].append((controls(rolled)[0] - base[0]) / roll_slope)
+                rudder.append(answer[2])
             obs, _, terminated, truncated, _ = env.step(np.clip(action, LOW, HIGH))
             if terminated or truncated:
                 break
@@ -77,6 +83,8 @@ def main() -> None:
     for what, values in ratios.items():
         p10, p50, p90 = np.percentile(values, [10, 50, 90])
         print(f"clone / autopilot, {what} error: median {p50:.2f} (p10 {p10:.2f}, p90 {p90:.2f})")
+    p10, p50, p90 = np.percentile(rudder, [10, 50, 90])
+    print(f"rudder per degree of heading error: median {p50:+.4f} (p10 {p10:+.4f}, p90 {p90:+.4f})")
 
 
 if __name__ == "__main__":
