@@ -212,10 +212,17 @@ def _bc(args: argparse.Namespace) -> int:
 
     result = train_bc(cfg, on_epoch, frames, on_start)
     bar.close()
+    val = result.val_loss[-1]
+    held = (
+        f"validation {val:.4f}"
+        if val == val  # not NaN: some episodes were held out
+        else f"no validation loss (--val-fraction {cfg.val_fraction:g} of the episodes is "
+        "less than one: every one trained)"
+    )
     print(
         f"trained {result.meta['name']} on {result.meta['train']['train_frames']} frames "
         f"({result.frames / result.seconds:,.0f} frames/s): loss {result.train_loss[0]:.4f} "
-        f"-> {result.train_loss[-1]:.4f}, validation {result.val_loss[-1]:.4f}"
+        f"-> {result.train_loss[-1]:.4f}, {held}"
     )
     print(f"policy saved to {result.out} (loss curve: {result.out / 'loss.png'})")
     if result.overfit:

@@ -37,7 +37,9 @@ class TrainConfig:
         lr: AdamW learning rate (cosine-decayed to 5 % over the run).
         weight_decay: AdamW weight decay.
         seed: seeds the split, the initialisation and the shuffling.
-        val_fraction: share of episodes held out for validation loss (whole episodes).
+        val_fraction: share of the episodes held out for a validation loss (whole
+            episodes, rounded down: none where the share is under one episode, so that
+            five demonstrations all train; 0.2 holds one of five out).
         device: cpu, cuda, or auto (cuda when present).
         obs_noise: std of Gaussian noise added to the normalised observations while training
             (0 = none).

@@ -21,11 +21,14 @@ def fly_episode(env, agent, seed):
     return trace_of(Rollout(env, [agent]).episode(seed))
 
 
+def cfg_like(dataset, out):
+    """The module's training run: one of the tiny dataset's six episodes held out."""
+    return TrainConfig(dataset=dataset, out=out, epochs=25, seed=3, val_fraction=0.17)
+
+
 @pytest.fixture(scope="module")
 def trained(tiny_dataset, tmp_path_factory):
-    out = tmp_path_factory.mktemp("policy")
-    cfg = TrainConfig(dataset=tiny_dataset, out=out, epochs=25, seed=3)
-    return train_bc(cfg)
+    return train_bc(cfg_like(tiny_dataset, tmp_path_factory.mktemp("policy")))
 
 
 def test_loss_falls_and_checkpoint_is_complete(trained):
@@ -40,7 +43,7 @@ def test_loss_falls_and_checkpoint_is_complete(trained):
 
 
 def test_training_is_reproducible_with_a_seed(trained, tiny_dataset, tmp_path):
-    again = train_bc(TrainConfig(dataset=tiny_dataset, out=tmp_path, epochs=25, seed=3))
+    again = train_bc(cfg_like(tiny_dataset, tmp_path))
     assert again.train_loss == trained.train_loss
     assert (tmp_path / "model.safetensors").read_bytes() == (
         trained.out / "model.safetensors"
@@ -90,6 +93,18 @@ def test_batches_and_split(tiny_dataset):
     ep = train.episode
     starts = windows.starts.numpy()
     assert (ep[starts] == ep[starts + 15]).all()  # no window crosses an episode boundary
+
+
+def test_the_split_holds_out_its_share_of_the_episodes_and_none_below_one(tiny_dataset):
+    # six episodes: 10 % of them is under one, so all six train (five demonstrations at the
+    # default 0.1 train on all five, not on four)
+    frames = load_frames(tiny_dataset)
+    train, val = split_by_episode(frames, 0.1, seed=0)
+    assert val is None and train is frames
+    for fraction, held in ((0.17, 1), (0.5, 3), (0.99, 5)):  # one always trains
+        train, val = split_by_episode(frames, fraction, seed=0)
+        assert val is not None and len(np.unique(val.episode)) == held
+        assert len(np.unique(train.episode)) == 6 - held
 
 
 def test_human_gated_episodes_teach_only_their_takeovers(tiny_dataset):
