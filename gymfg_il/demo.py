@@ -91,7 +91,7 @@ def run(cfg: DemoConfig) -> int:
     from gymfg_il.evaluation.config import EvalConfig
     from gymfg_il.evaluation.runner import run_eval
     from gymfg_il.learning.bc import train_bc
-    from gymfg_il.learning.config import TrainConfig
+    from gymfg_il.learning.config import TrainConfig, validation_words
 
     hub_offline()
     started = time.perf_counter()
@@ -119,7 +119,8 @@ def run(cfg: DemoConfig) -> int:
     print(f"[2/3] behaviour cloning -> {policy}", flush=True)
     epoch_tick = _bar(cfg.progress, "epoch")(cfg.epochs)
     trained = train_bc(train, lambda *_: epoch_tick())
-    print(f"      validation loss {trained.val_loss[-1]:.4f}", flush=True)
+    held = validation_words(trained.val_loss[-1], trained.meta["train"]["val_frames"])
+    print(f"      {held}", flush=True)
     print(f"[3/3] evaluating against the controller on {cfg.episodes} held-out seeds", flush=True)
     evaluation = EvalConfig(
         policy=[policy],

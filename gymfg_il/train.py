@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 import sys
 import typing
 from importlib.util import find_spec
@@ -186,7 +187,7 @@ def _bc(args: argparse.Namespace) -> int:
     from gymfg_il import cli
     from gymfg_il.datasets.lerobot_api import hub_offline
     from gymfg_il.learning.bc import train_bc
-    from gymfg_il.learning.config import TrainConfig
+    from gymfg_il.learning.config import TrainConfig, validation_words
     from gymfg_il.learning.data import load_frames
     from gymfg_il.learning.fit import Estimate
 
@@ -208,17 +209,11 @@ def _bc(args: argparse.Namespace) -> int:
 
     def on_epoch(epoch: int, train: float, val: float) -> None:
         bar.update(1)
-        bar.set_postfix(loss=f"{train:.4f}", val=f"{val:.4f}")
+        bar.set_postfix(loss=f"{train:.4f}", **({} if math.isnan(val) else {"val": f"{val:.4f}"}))
 
     result = train_bc(cfg, on_epoch, frames, on_start)
     bar.close()
-    val = result.val_loss[-1]
-    held = (
-        f"validation {val:.4f}"
-        if val == val  # not NaN: some episodes were held out
-        else f"no validation loss (--val-fraction {cfg.val_fraction:g} of the episodes is "
-        "less than one: every one trained)"
-    )
+    held = validation_words(result.val_loss[-1], result.meta["train"]["val_frames"])
     print(
         f"trained {result.meta['name']} on {result.meta['train']['train_frames']} frames "
         f"({result.frames / result.seconds:,.0f} frames/s): loss {result.train_loss[0]:.4f} "

@@ -45,7 +45,8 @@ RUDDER = {
 @contextlib.contextmanager
 def rudder_holding_heading(per_deg: float, per_deg_s: float) -> Iterator[None]:
     """The autopilot's rudder, plus ``-per_deg`` x the heading error (clipped at 5 deg) and
-    ``-per_deg_s`` x the yaw rate, on the heading loop (positive rudder yaws left here)."""
+    ``+per_deg_s`` x the yaw rate, on the heading loop (positive rudder yaws left here, a
+    positive yaw rate is the nose going right: the second term damps it)."""
     own = Autopilot._rudder
 
     def rudder(self: Autopilot, obs: list[float]) -> float:

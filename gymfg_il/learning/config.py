@@ -19,6 +19,16 @@ DEFAULT_DATASET = Path("datasets/sample-altitude-c172p/dataset")
 EPOCHS_AUTOPILOT, EPOCHS_PERSON = 60, 20  # the default epochs (TrainConfig.epochs)
 
 
+def validation_words(loss: float, held_frames: int | None = None) -> str:
+    """The validation loss in words for a report line: ``validation loss 0.0123``, or why
+    there is none (``held_frames``: the frames held out, where the caller knows them)."""
+    if not math.isnan(loss):
+        return f"validation loss {loss:.4f}"
+    if held_frames:
+        return "no validation loss (the held-out episodes are shorter than the policy's window)"
+    return "no validation loss (no episode held out: --val-fraction of them is under one)"
+
+
 @dataclass
 class TrainConfig:
     """Behaviour-cloning run.

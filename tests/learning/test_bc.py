@@ -101,7 +101,7 @@ def test_the_split_holds_out_its_share_of_the_episodes_and_none_below_one(tiny_d
     frames = load_frames(tiny_dataset)
     train, val = split_by_episode(frames, 0.1, seed=0)
     assert val is None and train is frames
-    for fraction, held in ((0.17, 1), (0.5, 3), (0.99, 5)):  # one always trains
+    for fraction, held in ((0.17, 1), (0.5, 3), (0.99, 5), (1 - 1e-12, 5)):  # one trains
         train, val = split_by_episode(frames, fraction, seed=0)
         assert val is not None and len(np.unique(val.episode)) == held
         assert len(np.unique(train.episode)) == 6 - held

@@ -12,7 +12,6 @@ from functools import partial
 import numpy as np
 import pytest
 import torch
-from stable_baselines3.common.logger import Logger
 
 pytest.importorskip("stable_baselines3")
 
@@ -50,6 +49,8 @@ def _model(n_envs, tmp_path, sampler="grouped", episode_time_s=3.0):
         seed=2, sampler=sampler,
     )  # fmt: skip
     model = make_model(cfg, venv, module, tmp_path, "cpu", flight.agent_hz)
+    from stable_baselines3.common.logger import Logger
+
     model.set_logger(Logger(folder=None, output_formats=[]))  # no log folder, none in /tmp
     _, callback = model._setup_learn(10**6, callback=None)
     return model, callback
