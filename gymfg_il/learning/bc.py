@@ -93,7 +93,7 @@ def _train(
 ) -> TrainResult:
     from gymfg_il.learning.data import split_by_episode
     from gymfg_il.learning.fit import Steps, estimate, fit
-    from gymfg_il.learning.saving import check_diverged, save_run
+    from gymfg_il.learning.saving import check_diverged, finite_or_null, save_run
 
     device = resolve_device(cfg.device)
     window = cfg.policy.window
@@ -124,7 +124,7 @@ def _train(
         "train_frames": len(train),  # not "frames": a vision policy's setting once
         "val_frames": len(val) if val else 0,
         "train_loss": train_loss,
-        "val_loss": val_loss,
+        "val_loss": finite_or_null(val_loss),
         "seconds": seconds,
         **shift,
     }

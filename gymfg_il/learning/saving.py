@@ -37,6 +37,12 @@ def check_diverged(
     )
 
 
+def finite_or_null(losses: list[float]) -> list[float | None]:
+    """``losses`` for a JSON file: null where there is none (NaN: no episode held out), so
+    that the file is JSON every reader parses, not Python's ``NaN``."""
+    return [None if math.isnan(v) else v for v in losses]
+
+
 def save_run(
     out: Path,
     policy: Any,
@@ -55,7 +61,7 @@ def save_run(
             save_policy(policy, folder, meta, *stats)
             label = getattr(policy, "loss_label", "loss")
             plot_losses(train, val, folder / "loss.png", str(meta["name"]), label)
-            text = json.dumps({"train_loss": train, "val_loss": val}, indent=1)
+            text = json.dumps({"train_loss": train, "val_loss": finite_or_null(val)}, indent=1)
             (folder / "train_log.json").write_text(text)
     except OSError as err:
         if disk_full(err):

@@ -1,4 +1,5 @@
 import json
+import math
 
 import numpy as np
 import pytest
@@ -105,6 +106,21 @@ def test_the_split_holds_out_its_share_of_the_episodes_and_none_below_one(tiny_d
         train, val = split_by_episode(frames, fraction, seed=0)
         assert val is not None and len(np.unique(val.episode)) == held
         assert len(np.unique(train.episode)) == 6 - held
+
+
+def test_a_run_with_no_episode_held_out_writes_json_every_reader_parses(tiny_dataset, tmp_path):
+    # six episodes at the default 0.1: none held out, so no validation loss, written as null
+    result = train_bc(TrainConfig(dataset=tiny_dataset, out=tmp_path, epochs=1))
+    assert math.isnan(result.val_loss[-1])
+
+    def refuse(constant):
+        raise AssertionError(f"{constant} is not JSON")
+
+    for name in ("config.json", "train_log.json"):
+        text = (tmp_path / name).read_text()
+        found = json.loads(text, parse_constant=refuse)
+        log = found["train"] if name == "config.json" else found
+        assert log["val_loss"] == [None] and math.isfinite(log["train_loss"][0])
 
 
 def test_human_gated_episodes_teach_only_their_takeovers(tiny_dataset):
