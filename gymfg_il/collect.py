@@ -322,14 +322,13 @@ def _web(args: argparse.Namespace) -> int:
 
 def _dagger(args: argparse.Namespace) -> int:
     from gymfg_il import cli
-    from gymfg_il.learning.config import validation_words
     from gymfg_il.learning.dagger import DaggerConfig, DaggerIteration
 
     def report(step: DaggerIteration) -> None:
         print(
             f"iteration {step.iteration}: policy return {step.policy_return:.1f} over "
             f"{step.episodes} episodes; dataset {step.dataset_episodes} episodes; retrained "
-            f"-> {step.policy} ({validation_words(step.val_loss)})",
+            f"-> {step.policy} ({step.validation})",
             flush=True,
         )
 

@@ -19,7 +19,7 @@ from gymfg_il.datasets.episode_logs import link_base_logs
 from gymfg_il.datasets.videos import IMAGE_PREFIX
 from gymfg_il.envs.flight import FlightSpec
 from gymfg_il.errors import ConfigError
-from gymfg_il.learning.config import TrainConfig
+from gymfg_il.learning.config import TrainConfig, validation_words
 from gymfg_il.rollout.agents import AgentSpec
 from gymfg_il.workers import Workers
 
@@ -85,6 +85,11 @@ class DaggerIteration:
     dataset_episodes: int
     policy: Path
     val_loss: float
+
+    @property
+    def validation(self) -> str:
+        """The retrained policy's validation loss in words (``validation_words``)."""
+        return validation_words(self.val_loss)
 
 
 def run_dagger(
