@@ -184,13 +184,12 @@ def split_by_episode(
     frames: Frames, val_fraction: float, seed: int
 ) -> tuple[Frames, Frames | None]:
     """Hold out whole episodes for validation (never frames of a training episode): the
-    whole ``val_fraction`` of them, never more, and none where that is less than one episode
-    (from 5 episodes at 0.1, every episode trains). A fifth of five demonstrations held out
-    for a diagnostic loss cost the turn's clone from five 6 points of success and 3 crashes
-    in 160 episodes (docs/results/memory.md)."""
+    ``val_fraction`` of them rounded down, at most all but one, and none where that is less
+    than one episode (from 5 episodes at 0.1, every episode trains)."""
     if not 0.0 <= val_fraction < 1.0:
         raise ConfigError(f"val_fraction={val_fraction} must lie in [0, 1)")
     ids = np.unique(frames.episode)
+    # the 1e-9: a product such as 100 x 0.29 = 28.999999999999996 still holds out 29
     n_val = min(math.floor(len(ids) * val_fraction + 1e-9), len(ids) - 1)
     if n_val <= 0:
         return frames, None
